@@ -1,0 +1,460 @@
+"""Scenes: parsing, validation and the derived physical parameters.
+
+A scene is a TOML file in SI units. Validation happens in one place
+(:func:`validate`) for files, dictionaries and ``--set`` overrides alike, and
+every rule raises :class:`~beltsim.errors.SceneError` with a one-line message
+that names the key and the rule.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from .errors import SceneError
+
+# ---------------------------------------------------------------------------
+# Schema
+
+
+class _Rule:
+    """Type and range rule of one key."""
+
+    def __init__(self, kind, *, positive=False, nonneg=False, choices=None, interval=None,
+                 minimum=None):
+        self.kind = kind  # "float", "int", "bool", "str"
+        self.positive = positive
+        self.nonneg = nonneg
+        self.choices = choices
+        self.interval = interval  # open interval (lo, hi)
+        self.minimum = minimum  # inclusive lower bound (ints, floats)
+
+    def check(self, key, value):
+        if self.kind in ("float", "int"):
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise SceneError(f"{key}: must be a number, got {_show(value)}")
+            if self.kind == "int":
+                if isinstance(value, float):
+                    if not (math.isfinite(value) and value == int(value)):
+                        raise SceneError(f"{key}: must be a whole number, got {_show(value)}")
+                    value = int(value)
+            value = value if self.kind == "int" else float(value)
+            if not math.isfinite(value):
+                raise SceneError(f"{key}: must be finite, got {_show(value)}")
+            if self.positive and not value > 0:
+                raise SceneError(f"{key}: must be > 0, got {_show(value)}")
+            if self.nonneg and not value >= 0:
+                raise SceneError(f"{key}: must be >= 0, got {_show(value)}")
+            if self.minimum is not None and value < self.minimum:
+                raise SceneError(f"{key}: must be >= {self.minimum}, got {_show(value)}")
+            if self.interval is not None:
+                lo, hi = self.interval
+                if not lo < value < hi:
+                    raise SceneError(f"{key}: must lie in the open interval ({lo}, {hi}), "
+                                     f"got {_show(value)}")
+            return value
+        if self.kind == "bool":
+            if not isinstance(value, bool):
+                raise SceneError(f"{key}: must be true or false, got {_show(value)}")
+            return value
+        if self.kind == "str":
+            if not isinstance(value, str):
+                raise SceneError(f"{key}: must be a string, got {_show(value)}")
+            if self.choices is not None and value not in self.choices:
+                opts = " | ".join(f'"{c}"' for c in self.choices)
+                raise SceneError(f"{key}: must be one of {opts}, got {_show(value)}")
+            return value
+        raise AssertionError(self.kind)
+
+
+def _show(value):
+    if isinstance(value, str):
+        return repr(value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, list):
+        return "an array"
+    return repr(value)
+
+
+POS = _Rule("float", positive=True)
+
+#: Sections, their keys and rules. ``None`` in REQUIRED means optional section.
+SCHEMA: dict[str, dict[str, _Rule]] = {
+    "beam": {
+        "length": POS,
+        "height": POS,
+        "width": POS,
+        "youngs_modulus": POS,
+        "poisson_ratio": _Rule("float", interval=(-1.0, 0.5)),
+        "density": POS,
+        "shear_factor": POS,
+    },
+    "motion": {"belt_speed": POS, "surface_speed": POS},
+    "contact": {
+        "start": _Rule("float"),
+        "end": _Rule("float"),
+        "friction": _Rule("str", choices=("stick", "coulomb")),
+        "max_friction": POS,
+    },
+    "physics": {"inertia": _Rule("bool")},
+    "stiffness": {
+        "bending": POS,
+        "tension": POS,
+        "shear": POS,
+        "mass": POS,
+        "rotary_inertia": POS,
+    },
+    "numerics": {
+        "integrator": _Rule("str", choices=("implicit", "explicit", "steady")),
+        "elements": _Rule("int", minimum=6),
+        "grading": _Rule("float", minimum=1.0),
+        "dt": POS,
+        "t_end": POS,
+        "ramp_time": _Rule("float", nonneg=True),
+        "regularisation": POS,
+        "friction_law": _Rule("str", choices=("tanh", "sqrt", "ramp")),
+        "adhesion_layer": POS,
+        "damping": _Rule("float", nonneg=True),
+        "steady_tol": POS,
+        "snapshot_interval": POS,
+    },
+}
+
+REQUIRED_SECTIONS = ("beam", "motion", "contact", "physics")
+OPTIONAL_SECTIONS = ("stiffness", "numerics")
+TOP_LEVEL_KEYS = ("title",)
+
+# Keys that only make sense for some scenes ("a scene holds only what it needs").
+_ONLY_COULOMB = {("contact", "max_friction"), ("numerics", "regularisation"),
+                 ("numerics", "friction_law")}
+_ONLY_STICK = {("numerics", "adhesion_layer")}
+_ONLY_INERTIA = {("stiffness", "mass"), ("stiffness", "rotary_inertia"), ("numerics", "damping")}
+
+
+def validate(data: dict) -> dict:
+    """Check a scene dictionary and return a normalised deep copy.
+
+    Raises SceneError on the first broken rule.
+    """
+    if not isinstance(data, dict):
+        raise SceneError("scene: must be a TOML table")
+    out: dict = {}
+    for key, value in data.items():
+        if key in SCHEMA:
+            if not isinstance(value, dict):
+                raise SceneError(f"[{key}]: must be a table (section), got {_show(value)}")
+            continue
+        if key == "title":
+            if not isinstance(value, str):
+                raise SceneError(f"title: must be a string, got {_show(value)}")
+            out["title"] = value
+            continue
+        known = ", ".join([f"[{s}]" for s in SCHEMA] + list(TOP_LEVEL_KEYS))
+        raise SceneError(f"{key}: unknown section or key (known: {known})")
+    for section in REQUIRED_SECTIONS:
+        if section not in data:
+            raise SceneError(f"[{section}]: missing section")
+    for section, rules in SCHEMA.items():
+        if section not in data:
+            continue
+        table = data[section]
+        clean = {}
+        for key, value in table.items():
+            name = f"{section}.{key}"
+            if key not in rules:
+                raise SceneError(f"{name}: unknown key (known in [{section}]: "
+                                 f"{', '.join(rules)})")
+            clean[key] = rules[key].check(name, value)
+        out[section] = clean
+
+    friction = out["contact"].get("friction")
+    inertia = out["physics"].get("inertia")
+    for section, rules in SCHEMA.items():
+        if section in OPTIONAL_SECTIONS:
+            continue
+        for key in rules:
+            if key in out[section]:
+                continue
+            name = f"{section}.{key}"
+            if (section, key) == ("contact", "max_friction"):
+                if friction == "coulomb":
+                    raise SceneError(f"{name}: missing key (required when contact.friction = "
+                                     f'"coulomb")')
+                continue
+            if (section, key) == ("beam", "density") and inertia is False:
+                continue  # a quasistatic scene needs no density
+            raise SceneError(f"{name}: missing key")
+
+    for section, key in _ONLY_COULOMB:
+        if key in out.get(section, {}) and friction != "coulomb":
+            raise SceneError(f'{section}.{key}: only for contact.friction = "coulomb" '
+                             f'(this scene is "{friction}")')
+    for section, key in _ONLY_STICK:
+        if key in out.get(section, {}) and friction != "stick":
+            raise SceneError(f'{section}.{key}: only for contact.friction = "stick" '
+                             f'(this scene is "{friction}")')
+    for section, key in _ONLY_INERTIA:
+        if key in out.get(section, {}) and not inertia:
+            raise SceneError(f"{section}.{key}: only for physics.inertia = true "
+                             f"(a quasistatic scene has no inertia terms)")
+    integ = out.get("numerics", {}).get("integrator")
+    if integ == "explicit" and not inertia:
+        raise SceneError('numerics.integrator: "explicit" needs physics.inertia = true '
+                         '(a quasistatic scene has no dynamics to step explicitly)')
+
+    beam, contact = out["beam"], out["contact"]
+    L, x1, x2 = beam["length"], contact["start"], contact["end"]
+    if not x1 < x2:
+        raise SceneError(f"contact.start: must be < contact.end, got start = {x1!r}, "
+                         f"end = {x2!r}")
+    if not (0.0 < x1 and x2 < L):
+        raise SceneError(f"contact.start/end: the contact must lie inside the beam, "
+                         f"0 < start < end < beam.length = {L!r}, got [{x1!r}, {x2!r}]")
+
+    p = _stiffness(out)
+    if inertia:
+        c = out["motion"]["belt_speed"]
+        c_t, c_b = math.sqrt(p["b1"] / p["rho"]), math.sqrt(p["a"] / p["I"])
+        if p["rho"] * c * c >= p["b1"] or p["I"] * c * c >= p["a"]:
+            raise SceneError(
+                f"motion.belt_speed: must stay below both critical speeds, "
+                f"sqrt(b1/rho) = {c_t:.6g} m/s and sqrt(a/I) = {c_b:.6g} m/s, got {c!r} m/s")
+    return out
+
+
+def _stiffness(d: dict) -> dict:
+    """Stiffness and inertia per unit length: derived from [beam], overridden by [stiffness]."""
+    beam = d["beam"]
+    over = d.get("stiffness", {})
+    E, nu, k = beam["youngs_modulus"], beam["poisson_ratio"], beam["shear_factor"]
+    h, w = beam["height"], beam["width"]
+    p = {
+        "a": over.get("bending", E * w * h**3 / 12.0),
+        "b1": over.get("tension", E * w * h),
+        "b2": over.get("shear", k * E * w * h / (2.0 * (1.0 + nu))),
+        "rho": 0.0,
+        "I": 0.0,
+    }
+    if d["physics"]["inertia"]:
+        rho3 = beam.get("density")
+        if rho3 is None and ("mass" not in over or "rotary_inertia" not in over):
+            raise SceneError("beam.density: missing key")
+        p["rho"] = over.get("mass", (rho3 or 0.0) * h * w)
+        p["I"] = over.get("rotary_inertia", (rho3 or 0.0) * h * w * (h * h + w * w) / 12.0)
+    return p
+
+
+# ---------------------------------------------------------------------------
+# Parameters
+
+
+@dataclass(frozen=True)
+class Params:
+    """The physical data a solver needs, in SI units.
+
+    ``rho`` and ``I`` are zero for a quasistatic scene and ``fstar`` is None
+    for a stick scene: a scene carries only the terms it has.
+    """
+
+    L: float
+    h: float
+    x1: float
+    x2: float
+    c: float
+    v: float
+    a: float
+    b1: float
+    b2: float
+    rho: float
+    I: float
+    inertia: bool
+    friction: str
+    fstar: float | None
+
+    @property
+    def e0(self) -> float:
+        """Imposed strain of the bottom fibre in stick, v/c - 1."""
+        return self.v / self.c - 1.0
+
+    @property
+    def A(self) -> float:
+        """Effective bending stiffness a - I c^2."""
+        return self.a - self.I * self.c**2
+
+    @property
+    def B(self) -> float:
+        """Effective tension stiffness b1 - rho c^2."""
+        return self.b1 - self.rho * self.c**2
+
+    @property
+    def critical_speeds(self) -> tuple[float, float]:
+        """sqrt(b1/rho) and sqrt(a/I); infinite for a quasistatic scene."""
+        if not self.inertia:
+            return math.inf, math.inf
+        return math.sqrt(self.b1 / self.rho), math.sqrt(self.a / self.I)
+
+
+# ---------------------------------------------------------------------------
+# Scene
+
+
+class Scene:
+    """A validated scene. Build it with :meth:`load`, :meth:`from_dict` or :meth:`with_overrides`."""
+
+    def __init__(self, data: dict, source: str | None = None):
+        self._data = validate(data)
+        self.source = source
+
+    # construction -----------------------------------------------------
+    @classmethod
+    def load(cls, path) -> "Scene":
+        path = Path(path)
+        try:
+            text = path.read_bytes()
+        except FileNotFoundError:
+            raise SceneError(f"{path}: scene file not found") from None
+        except IsADirectoryError:
+            raise SceneError(f"{path}: is a directory, not a scene file") from None
+        except OSError as exc:
+            raise SceneError(f"{path}: cannot read scene file ({exc.strerror})") from None
+        try:
+            data = tomllib.loads(text.decode("utf-8"))
+        except UnicodeDecodeError:
+            raise SceneError(f"{path}: not a UTF-8 text file") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise SceneError(f"{path}: malformed TOML ({exc})") from None
+        return cls(data, source=str(path))
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "Scene":
+        return cls(copy.deepcopy(data))
+
+    def to_dict(self) -> dict:
+        return copy.deepcopy(self._data)
+
+    def with_overrides(self, assignments) -> "Scene":
+        """Apply ``SECTION.KEY=VALUE`` strings (or (key, value) pairs) and revalidate."""
+        data = self.to_dict()
+        for item in assignments:
+            if isinstance(item, str):
+                key, value = parse_assignment(item)
+            else:
+                key, value = item
+            set_key(data, key, value)
+        return Scene(data, source=self.source)
+
+    def replace(self, **kw) -> "Scene":
+        """Return a copy with ``section__key=value`` replaced (``None`` deletes the key)."""
+        data = self.to_dict()
+        for name, value in kw.items():
+            section, key = name.split("__")
+            if value is None:
+                data.get(section, {}).pop(key, None)
+            else:
+                data.setdefault(section, {})[key] = value
+        return Scene(data, source=self.source)
+
+    # accessors --------------------------------------------------------
+    def __getitem__(self, section):
+        return copy.deepcopy(self._data[section])
+
+    def get(self, dotted: str, default=None):
+        section, key = dotted.split(".", 1)
+        return self._data.get(section, {}).get(key, default)
+
+    @property
+    def title(self) -> str:
+        return self._data.get("title", "")
+
+    @property
+    def numerics(self) -> dict:
+        return dict(self._data.get("numerics", {}))
+
+    @property
+    def params(self) -> Params:
+        d = self._data
+        p = _stiffness(d)
+        contact = d["contact"]
+        return Params(
+            L=d["beam"]["length"], h=d["beam"]["height"],
+            x1=contact["start"], x2=contact["end"],
+            c=d["motion"]["belt_speed"], v=d["motion"]["surface_speed"],
+            a=p["a"], b1=p["b1"], b2=p["b2"], rho=p["rho"], I=p["I"],
+            inertia=d["physics"]["inertia"], friction=contact["friction"],
+            fstar=contact.get("max_friction"),
+        )
+
+    def to_toml(self) -> str:
+        """Serialise back to TOML (provenance file beside a run's outputs)."""
+        lines = []
+        if "title" in self._data:
+            lines.append(f"title = {_toml_value(self._data['title'])}")
+        for section in SCHEMA:
+            if section not in self._data:
+                continue
+            lines.append(f"\n[{section}]")
+            for key, value in self._data[section].items():
+                lines.append(f"{key} = {_toml_value(value)}")
+        return "\n".join(lines).lstrip("\n") + "\n"
+
+    def __repr__(self):
+        return f"Scene({self.title or self.source or 'untitled'!r})"
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, int):
+        return str(value)
+    escaped = value.replace("\\", "\\\\").replace('"', '\\"')
+    return f'"{escaped}"'
+
+
+def parse_assignment(text: str):
+    """Split ``SECTION.KEY=VALUE`` and parse VALUE as a TOML value (bare words as strings)."""
+    if "=" not in text:
+        raise SceneError(f"--set {text}: expected SECTION.KEY=VALUE")
+    key, raw = text.split("=", 1)
+    key, raw = key.strip(), raw.strip()
+    if raw == "":
+        raise SceneError(f"{key}: empty value in --set")
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        if raw.replace("_", "").isalnum() and not raw[0].isdigit():
+            value = raw  # bare word, e.g. friction=coulomb
+        else:
+            raise SceneError(f"{key}: cannot parse value {raw!r} in --set") from None
+    if isinstance(value, str) and raw.lower() in ("nan", "inf", "+inf", "-inf"):
+        value = float(raw)
+    return key, value
+
+
+def set_key(data: dict, key: str, value) -> None:
+    """Set ``SECTION.KEY`` in a scene dict; the key must be one the schema knows."""
+    if key == "title":
+        data["title"] = value
+        return
+    if "." not in key:
+        raise SceneError(f"{key}: expected SECTION.KEY (sections: {', '.join(SCHEMA)})")
+    section, name = key.split(".", 1)
+    if section not in SCHEMA:
+        raise SceneError(f"{key}: unknown section [{section}] (sections: {', '.join(SCHEMA)})")
+    if name not in SCHEMA[section]:
+        raise SceneError(f"{key}: unknown key (known in [{section}]: "
+                         f"{', '.join(SCHEMA[section])})")
+    data.setdefault(section, {})[name] = value
+
+
+def load_scene(path, overrides=()) -> Scene:
+    """Load a scene file and apply ``SECTION.KEY=VALUE`` overrides."""
+    scene = Scene.load(path)
+    return scene.with_overrides(overrides) if overrides else scene
