@@ -1,0 +1,94 @@
+"""Command-line interface: a thin layer over the Python API.
+
+Exit status: 0 success, 2 bad input (scene, --set, output directory), 3 a run
+that stopped on a numerical failure, 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .errors import BeltsimError, NumericalError
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2, as for a bad scene
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def _add_scene_args(p):
+    p.add_argument("scene", help="scene file (TOML)")
+    p.add_argument("--set", dest="overrides", action="append", default=[],
+                   metavar="SECTION.KEY=VALUE", help="override a scene key (repeatable)")
+
+
+def _scene(args):
+    from .scene import load_scene
+    return load_scene(args.scene, args.overrides)
+
+
+# ---------------------------------------------------------------------------
+# commands
+
+
+def cmd_analytic(args):
+    from . import analytic
+    from .results import prepare_outdir, write_fields, write_json
+
+    scene = _scene(args)
+    sol = analytic.solve(scene)
+    out = prepare_outdir(args.out)
+    x, fields = sol.sample()
+    summary = sol.summary()
+    write_json(out / "summary.json", summary)
+    write_fields(out / "fields.csv", x, fields)
+    print(format_summary(summary, title=scene.title or args.scene))
+    print(f"wrote {out / 'summary.json'} and {out / 'fields.csv'}")
+    return 0
+
+
+def format_summary(summary: dict, title: str = "") -> str:
+    """A short human-readable table of a summary dict."""
+    rows = [("model", summary["model"]), ("inertia", str(summary["inertia"]).lower())]
+    for key, unit in (("total_friction", "N"), ("concentrated_force", "N"),
+                      ("distributed_friction", "N"), ("stick_friction", "N"),
+                      ("slip_friction", "N"), ("slip_start", "m")):
+        value = summary.get(key)
+        if value is not None:
+            rows.append((key, f"{value:.6g} {unit}"))
+    width = max(len(k) for k, _ in rows)
+    lines = [title] if title else []
+    lines += [f"  {k:<{width}}  {v}" for k, v in rows]
+    return "\n".join(lines)
+
+
+def build_parser():
+    parser = _Parser(prog="beltsim", description="Belt-drive contact mechanics: analytic "
+                     "steady solutions and transient Eulerian simulation.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    p = sub.add_parser("analytic", help="analytic steady solution of a scene")
+    _add_scene_args(p)
+    p.add_argument("--out", default="runs/out/analytic", help="output directory")
+    p.set_defaults(func=cmd_analytic)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except NumericalError as exc:
+        print(f"beltsim: numerical failure: {exc}", file=sys.stderr)
+        return 3
+    except BeltsimError as exc:
+        print(f"beltsim: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("beltsim: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

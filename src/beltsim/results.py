@@ -1,0 +1,102 @@
+"""Results and I/O: summary.json, fields.csv, history.csv, all written atomically.
+
+Every file goes to a temporary name in the same directory and is renamed into
+place, so an interrupted or killed run never leaves a half-written output.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from .errors import BeltsimError
+
+FIELDS_HEADER = ("x", "u", "theta", "strain", "tension", "moment", "friction")
+
+
+class OutputError(BeltsimError, ValueError):
+    """The output directory cannot be created or written."""
+
+
+def prepare_outdir(path) -> Path:
+    """Create the output directory (and parents), or fail with a one-line reason."""
+    path = Path(path)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise OutputError(f"--out {path}: exists and is not a directory") from None
+    except OSError as exc:
+        raise OutputError(f"--out {path}: cannot create directory ({exc.strerror})") from None
+    if not os.access(path, os.W_OK | os.X_OK):
+        raise OutputError(f"--out {path}: directory is not writable")
+    return path
+
+
+def write_atomic(path, data: bytes | str) -> Path:
+    """Write ``data`` to ``path`` through a temporary file and a rename."""
+    path = Path(path)
+    if isinstance(data, str):
+        data = data.encode("utf-8")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write ({exc.strerror})") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+    return path
+
+
+def _jsonable(value):
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        # JSON has no NaN; a missing number is null, never a fake value
+        return value if math.isfinite(value) else None
+    return value
+
+
+def write_json(path, obj) -> Path:
+    return write_atomic(path, json.dumps(_jsonable(obj), indent=2) + "\n")
+
+
+def write_csv(path, header, columns) -> Path:
+    """Columns of equal length under a header, full double precision."""
+    cols = [np.asarray(c, dtype=float) for c in columns]
+    table = np.column_stack(cols) if cols else np.empty((0, 0))
+    lines = [",".join(header)]
+    lines += [",".join(repr(float(v)) for v in row) for row in table]
+    return write_atomic(path, "\n".join(lines) + "\n")
+
+
+def write_fields(path, x, fields: dict) -> Path:
+    return write_csv(path, FIELDS_HEADER, [x] + [fields[k] for k in FIELDS_HEADER[1:]])
+
+
+def read_csv(path) -> dict:
+    """Read a CSV written by :func:`write_csv` into a dict of arrays."""
+    with open(path) as fh:
+        header = fh.readline().strip().split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    return {name: data[:, i] for i, name in enumerate(header)}
