@@ -1,0 +1,75 @@
+"""Friction laws: regularised Coulomb, and the unlimited law of perfect adhesion.
+
+The traction on the belt is f = -f_s g(v_rel / v_reg), with g odd, increasing
+and (for Coulomb) saturating at 1. Perfect adhesion is the "linear" law
+g(s) = s with a stiff slope f_s / v_reg; as v_reg -> 0 (Coulomb) or the slope
+-> infinity (adhesion) the regularised problem tends to the exact one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+LINEAR, TANH, SQRT, RAMP = 0, 1, 2, 3
+LAW_CODES = {"linear": LINEAR, "tanh": TANH, "sqrt": SQRT, "ramp": RAMP}
+
+
+@njit(cache=True)
+def law(code, s):
+    """g(s) and g'(s) of the regularisation ``code``."""
+    if code == TANH:
+        g = math.tanh(s)
+        return g, 1.0 - g * g
+    if code == SQRT:
+        r = 1.0 / math.sqrt(1.0 + s * s)
+        return s * r, r * r * r
+    if code == RAMP:
+        if s > 1.0:
+            return 1.0, 0.0
+        if s < -1.0:
+            return -1.0, 0.0
+        return s, 1.0
+    return s, 1.0
+
+
+@njit(cache=True)
+def law_inverse(code, lam):
+    """g^{-1}(lam) and its derivative, for the laws with a smooth inverse (|lam| < 1).
+
+    The primal-dual Newton iteration carries lam = g(v_rel / v_reg) as an unknown:
+    its inverse is well conditioned where the primal law is nearly flat (sliding)
+    and the other way round in stick.
+    """
+    if code == LINEAR:
+        return lam, 1.0
+    q = 1.0 - lam * lam  # > 0: the iteration keeps |lam| < 1
+    if code == TANH:
+        return math.atanh(lam), 1.0 / q
+    return lam / math.sqrt(q), 1.0 / (q * math.sqrt(q))  # SQRT
+
+
+def has_dual(code) -> bool:
+    """Whether the primal-dual iteration applies (the ramp's inverse is set-valued)."""
+    return code != RAMP
+
+
+def law_numpy(code, s):
+    """Vectorised twin of :func:`law` (tests, post-processing)."""
+    s = np.asarray(s, dtype=float)
+    if code == TANH:
+        g = np.tanh(s)
+        return g, 1.0 - g * g
+    if code == SQRT:
+        r = 1.0 / np.sqrt(1.0 + s * s)
+        return s * r, r**3
+    if code == RAMP:
+        return np.clip(s, -1.0, 1.0), (np.abs(s) <= 1.0).astype(float)
+    return s, np.ones_like(s)
+
+
+def saturation(code) -> float:
+    """Level of |g| above which an element counts as sliding."""
+    return 0.99 if code in (TANH, SQRT) else 1.0 - 1e-12

@@ -1,0 +1,254 @@
+"""The discrete model: residual and Jacobian of the transient equations.
+
+Fields u, theta at the nodes of a fixed grid; the material flows through at
+speed c. With B = b1 - rho c^2 and A = a - I c^2 (``shared/NOTES.md``)::
+
+    rho (u_tt + 2 c u_xt) + d rho u_t = B u_xx + f
+    I (theta_tt + 2 c theta_xt) + d I theta_t = A theta_xx - b2 theta + (h/2) f
+    f = -f_s g(v_rel / v_reg),  v_rel = d/dt u_b + c d/dx u_b - (v(t) - c),  u_b = u + (h/2) theta
+
+Space: linear elements with lumped mass and shear (node-centred control
+volumes); the gyroscopic term 2 c u_xt is central (skew, energy neutral). The
+transport c d/dx u_b in the slip velocity is upwind: the slip velocity of the
+element [x_{j-1}, x_j] uses the bottom-fibre strain of that element and the
+velocity of its downstream node j, and the element's friction is lumped on node
+j. Treated centrally this term makes the friction alternate in sign from node
+to node in stick zones (NOTES, trap 1). The damping d acts on local time
+derivatives only, so it vanishes at steady state (trap 3).
+
+Time: the residual is written for backward Euler with ``inv_dt`` = 1/dt; with
+``inv_dt`` = 0 it is the discrete steady problem. Interior nodes 1..N-1 carry
+the unknowns (u_j, theta_j); the Jacobian is block tridiagonal with 2x2 blocks.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .friction import law, law_inverse, law_numpy
+
+# indices into the float parameter vector
+P_B, P_A, P_B2, P_RHO, P_I, P_C, P_HH, P_DAMP, P_FS, P_VREG, P_DV, P_TRAMP = range(12)
+N_PRM = 12
+# indices into the integer parameter vector
+I_LAW, I_J1, I_J2, I_DUAL = range(4)
+N_IPRM = 4
+# |lam| bound in the primal-dual iteration: the friction of a fully sliding node is
+# then f* (1 - 1e-14), and g^{-1} stays finite
+LAM_MAX = 1.0 - 1e-14
+
+
+@njit(cache=True)
+def ramp(t, t_ramp):
+    """Smooth (C2) ramp from 0 to 1 over [0, t_ramp]."""
+    if t_ramp <= 0.0 or t >= t_ramp:
+        return 1.0
+    if t <= 0.0:
+        return 0.0
+    s = t / t_ramp
+    return s * s * s * (10.0 - 15.0 * s + 6.0 * s * s)
+
+
+@njit(cache=True)
+def assemble(u, th, lam, uo, tho, udo, tdo, inv_dt, t, he, hb, prm, iprm, R, Lb, Db, Ub,
+             fnode, rl, sg, want_jac):
+    """Residual R (n, 2) of the interior nodes and, if want_jac, the Jacobian blocks.
+
+    u, th: trial values at t (N+1, boundary zeros); uo, tho, udo, tdo: values and
+    local velocities at the previous step. fnode receives the nodal friction
+    forces (N) of the trial state.
+
+    Friction ratio lam = g(v_rel / v_reg) at each contact node: in the primal
+    form (iprm[I_DUAL] = 0) it is computed from the trial state; in the
+    primal-dual form it is an unknown with the equation
+    rl = v_rel / v_reg - g^{-1}(lam) = 0, condensed node by node into the
+    (u, theta) rows so the Jacobian stays block tridiagonal. sg receives the
+    slope dlam/d(v_rel / v_reg) used by :func:`update_multipliers`.
+    """
+    N = u.shape[0] - 1
+    B, A, b2 = prm[P_B], prm[P_A], prm[P_B2]
+    rho, I, c, hh = prm[P_RHO], prm[P_I], prm[P_C], prm[P_HH]
+    damp, fs, vreg = prm[P_DAMP], prm[P_FS], prm[P_VREG]
+    target = prm[P_DV] * ramp(t, prm[P_TRAMP])
+    code, j1, j2, dual = iprm[I_LAW], iprm[I_J1], iprm[I_J2], iprm[I_DUAL]
+    kin = inv_dt * inv_dt + damp * inv_dt  # d(acc + damp * vel)/dy
+    for j in range(N + 1):
+        fnode[j] = 0.0
+    for j in range(1, N):
+        i = j - 1
+        hl, hr, hbj = he[j - 1], he[j], hb[j]
+        udj = (u[j] - uo[j]) * inv_dt
+        tdj = (th[j] - tho[j]) * inv_dt
+        ud_l = (u[j - 1] - uo[j - 1]) * inv_dt
+        ud_r = (u[j + 1] - uo[j + 1]) * inv_dt
+        td_l = (th[j - 1] - tho[j - 1]) * inv_dt
+        td_r = (th[j + 1] - tho[j + 1]) * inv_dt
+        acc_u = (udj - udo[j]) * inv_dt + damp * udj
+        acc_t = (tdj - tdo[j]) * inv_dt + damp * tdj
+        ru = (rho * hbj * acc_u + rho * c * (ud_r - ud_l)
+              - B * ((u[j + 1] - u[j]) / hr - (u[j] - u[j - 1]) / hl))
+        rt = (I * hbj * acc_t + I * c * (td_r - td_l)
+              - A * ((th[j + 1] - th[j]) / hr - (th[j] - th[j - 1]) / hl) + b2 * hbj * th[j])
+        if want_jac:
+            for a_ in range(2):
+                for b_ in range(2):
+                    Lb[i, a_, b_] = 0.0
+                    Db[i, a_, b_] = 0.0
+                    Ub[i, a_, b_] = 0.0
+            Db[i, 0, 0] = rho * hbj * kin + B * (1.0 / hl + 1.0 / hr)
+            Lb[i, 0, 0] = -rho * c * inv_dt - B / hl
+            Ub[i, 0, 0] = rho * c * inv_dt - B / hr
+            Db[i, 1, 1] = I * hbj * kin + A * (1.0 / hl + 1.0 / hr) + b2 * hbj
+            Lb[i, 1, 1] = -I * c * inv_dt - A / hl
+            Ub[i, 1, 1] = I * c * inv_dt - A / hr
+        if j > j1 and j <= j2:
+            # element [j-1, j]: upwind strain, velocity of the downstream node
+            ub = u[j] + hh * th[j]
+            ub_l = u[j - 1] + hh * th[j - 1]
+            ubo = uo[j] + hh * tho[j]
+            vrel = (ub - ubo) * inv_dt + c * (ub - ub_l) / hl - target
+            if dual:
+                gi, dgi = law_inverse(code, lam[j])
+                rl[j] = vrel / vreg - gi
+                sg[j] = 1.0 / dgi
+            else:
+                lam[j], sg[j] = law(code, vrel / vreg)
+                rl[j] = 0.0
+            fnode[j] = -hl * fs * lam[j]
+            ru += hl * fs * (lam[j] + sg[j] * rl[j])
+            rt += hh * hl * fs * (lam[j] + sg[j] * rl[j])
+            if want_jac:
+                k = hl * fs * sg[j] / vreg  # -dF/dv_rel
+                dd = k * (inv_dt + c / hl)
+                dl = -k * c / hl
+                Db[i, 0, 0] += dd
+                Db[i, 0, 1] += dd * hh
+                Db[i, 1, 0] += dd * hh
+                Db[i, 1, 1] += dd * hh * hh
+                Lb[i, 0, 0] += dl
+                Lb[i, 0, 1] += dl * hh
+                Lb[i, 1, 0] += dl * hh
+                Lb[i, 1, 1] += dl * hh * hh
+        R[i, 0] = ru
+        R[i, 1] = rt
+
+
+@njit(cache=True)
+def update_multipliers(lam, dx, inv_dt, he, prm, iprm, rl, sg):
+    """Newton update of the friction ratios after the condensed solve.
+
+    Each lam moves at most 99% of the way to the boundary of (-1, 1) (fraction to
+    the boundary) and stays within LAM_MAX of it, so g^{-1}(lam) stays finite.
+    Returns the largest change.
+    """
+    c, hh, vreg = prm[P_C], prm[P_HH], prm[P_VREG]
+    j1, j2 = iprm[I_J1], iprm[I_J2]
+    big = 0.0
+    for j in range(j1 + 1, j2 + 1):
+        hl = he[j - 1]
+        dub = dx[j - 1, 0] + hh * dx[j - 1, 1]
+        dub_l = dx[j - 2, 0] + hh * dx[j - 2, 1] if j >= 2 else 0.0
+        dvrel = (inv_dt + c / hl) * dub - (c / hl) * dub_l
+        dl = sg[j] * (rl[j] + dvrel / vreg)
+        if lam[j] + dl >= 1.0:
+            dl = 0.99 * (1.0 - lam[j])
+        elif lam[j] + dl <= -1.0:
+            dl = -0.99 * (1.0 + lam[j])
+        lam[j] = min(LAM_MAX, max(-LAM_MAX, lam[j] + dl))
+        if abs(dl) > big:
+            big = abs(dl)
+    return big
+
+
+@njit(cache=True)
+def block_solve(Lb, Db, Ub, r, x, C):
+    """Solve the block-tridiagonal system (2x2 blocks) by block Thomas; r is kept.
+
+    C is workspace (n, 2, 2). Returns False on a singular pivot block.
+    """
+    n = Db.shape[0]
+    y0 = np.empty(n)
+    y1 = np.empty(n)
+    for i in range(n):
+        c00, c01 = Db[i, 0, 0], Db[i, 0, 1]
+        c10, c11 = Db[i, 1, 0], Db[i, 1, 1]
+        r0, r1 = r[i, 0], r[i, 1]
+        if i > 0:
+            p00, p01, p10, p11 = C[i - 1, 0, 0], C[i - 1, 0, 1], C[i - 1, 1, 0], C[i - 1, 1, 1]
+            det = p00 * p11 - p01 * p10
+            # W = L_i C_{i-1}^{-1}
+            l00, l01, l10, l11 = Lb[i, 0, 0], Lb[i, 0, 1], Lb[i, 1, 0], Lb[i, 1, 1]
+            w00 = (l00 * p11 - l01 * p10) / det
+            w01 = (-l00 * p01 + l01 * p00) / det
+            w10 = (l10 * p11 - l11 * p10) / det
+            w11 = (-l10 * p01 + l11 * p00) / det
+            u00, u01, u10, u11 = Ub[i - 1, 0, 0], Ub[i - 1, 0, 1], Ub[i - 1, 1, 0], Ub[i - 1, 1, 1]
+            c00 -= w00 * u00 + w01 * u10
+            c01 -= w00 * u01 + w01 * u11
+            c10 -= w10 * u00 + w11 * u10
+            c11 -= w10 * u01 + w11 * u11
+            r0 -= w00 * y0[i - 1] + w01 * y1[i - 1]
+            r1 -= w10 * y0[i - 1] + w11 * y1[i - 1]
+        C[i, 0, 0], C[i, 0, 1], C[i, 1, 0], C[i, 1, 1] = c00, c01, c10, c11
+        y0[i], y1[i] = r0, r1
+    for i in range(n - 1, -1, -1):
+        r0, r1 = y0[i], y1[i]
+        if i < n - 1:
+            r0 -= Ub[i, 0, 0] * x[i + 1, 0] + Ub[i, 0, 1] * x[i + 1, 1]
+            r1 -= Ub[i, 1, 0] * x[i + 1, 0] + Ub[i, 1, 1] * x[i + 1, 1]
+        c00, c01, c10, c11 = C[i, 0, 0], C[i, 0, 1], C[i, 1, 0], C[i, 1, 1]
+        det = c00 * c11 - c01 * c10
+        if det == 0.0 or not math.isfinite(det):
+            return False
+        x[i, 0] = (c11 * r0 - c01 * r1) / det
+        x[i, 1] = (-c10 * r0 + c00 * r1) / det
+    return True
+
+
+# ---------------------------------------------------------------------------
+# numpy twins (tests and post-processing)
+
+
+def residual_numpy(u, th, uo, tho, udo, tdo, inv_dt, t, he, hb, prm, iprm):
+    """Vectorised twin of :func:`assemble` (residual and nodal friction only)."""
+    B, A, b2 = prm[P_B], prm[P_A], prm[P_B2]
+    rho, I, c, hh = prm[P_RHO], prm[P_I], prm[P_C], prm[P_HH]
+    damp, fs, vreg = prm[P_DAMP], prm[P_FS], prm[P_VREG]
+    tr = prm[P_TRAMP]
+    s = 1.0 if (tr <= 0 or t >= tr) else (0.0 if t <= 0 else (t / tr) ** 3 * (
+        10 - 15 * (t / tr) + 6 * (t / tr) ** 2))
+    code, j1, j2 = int(iprm[I_LAW]), int(iprm[I_J1]), int(iprm[I_J2])
+    ud = (u - uo) * inv_dt
+    td = (th - tho) * inv_dt
+    acc_u = (ud - udo) * inv_dt + damp * ud
+    acc_t = (td - tdo) * inv_dt + damp * td
+    eps = np.diff(u) / he
+    kap = np.diff(th) / he
+    ub = u + hh * th
+    F = np.zeros_like(u)
+    j = np.arange(j1 + 1, j2 + 1)
+    vrel = (ub[j] - (uo[j] + hh * tho[j])) * inv_dt + c * (ub[j] - ub[j - 1]) / he[j - 1] \
+        - prm[P_DV] * s
+    g, _ = law_numpy(code, vrel / vreg)
+    F[j] = -he[j - 1] * fs * g
+    sl = slice(1, -1)
+    ru = (rho * hb[sl] * acc_u[sl] + rho * c * (ud[2:] - ud[:-2]) - B * np.diff(eps) - F[sl])
+    rt = (I * hb[sl] * acc_t[sl] + I * c * (td[2:] - td[:-2]) - A * np.diff(kap)
+          + b2 * hb[sl] * th[sl] - hh * F[sl])
+    return np.column_stack([ru, rt]), F
+
+
+def blocks_to_dense(Lb, Db, Ub):
+    """Dense matrix of a block-tridiagonal Jacobian (tests)."""
+    n = Db.shape[0]
+    J = np.zeros((2 * n, 2 * n))
+    for i in range(n):
+        J[2 * i:2 * i + 2, 2 * i:2 * i + 2] = Db[i]
+        if i > 0:
+            J[2 * i:2 * i + 2, 2 * i - 2:2 * i] = Lb[i]
+        if i < n - 1:
+            J[2 * i:2 * i + 2, 2 * i + 2:2 * i + 4] = Ub[i]
+    return J

@@ -1,0 +1,121 @@
+"""Resolved numerical settings: the scene's [numerics] with scene-dependent defaults.
+
+Defaults (all overridable in [numerics]):
+
+* ``elements`` 1000, ``grading`` 8 (smallest element at x2, largest 8x bigger);
+* ``ramp_time`` 2 L / c: the surface speed goes smoothly from c to v;
+* ``dt`` ramp_time / 50;
+* ``t_end`` ramp_time + 400 L / c (a run that has not settled by then stops
+  with converged = false);
+* ``regularisation`` (coulomb) v_reg = 1e-4 |v - c|: the creep velocity in
+  stick zones is then ~1e-4 of the imposed one and the layer
+  (b1 - rho c^2) v_reg / (c f*) that replaces the jump at x* is far below an
+  element, so the regularisation error stays well below the grid's;
+* ``adhesion_layer`` (stick) delta = 1e-6 L: perfect adhesion is the linear law
+  f = -kappa v_rel with kappa = (b1 - rho c^2) / (c delta), which spreads the
+  concentrated force over a layer of width delta upstream of x2;
+* ``damping`` (inertia) 2 omega_1 with omega_1 = pi (b1 - rho c^2) / (L sqrt(rho b1)),
+  the lowest axial frequency of the free span: it acts on u_t and theta_t only;
+* ``steady_tol`` 1e-6: relative rates and relative change of the total friction
+  per window (one transit time L / c) that count as steady.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import SceneError
+from .friction import LAW_CODES, LINEAR, has_dual
+from .grid import Grid, make_grid
+from .model import (I_DUAL, I_J1, I_J2, I_LAW, N_IPRM, N_PRM, P_A, P_B, P_B2, P_C, P_DAMP, P_DV, P_FS, P_HH,
+                    P_I, P_RHO, P_TRAMP, P_VREG)
+from .scene import Params, Scene
+
+DEFAULT_ELEMENTS = 1000
+DEFAULT_GRADING = 8.0
+
+
+@dataclass(frozen=True)
+class Numerics:
+    integrator: str
+    elements: int
+    grading: float
+    dt: float
+    t_end: float
+    ramp_time: float
+    law: str
+    vreg: float  # regularisation velocity (law argument scale)
+    fs: float  # friction scale: f = -fs g(v_rel / vreg)
+    damping: float
+    steady_tol: float
+    snapshot_interval: float | None
+    newton_tol: float = 1e-9
+    newton_max_it: int = 30
+
+    @property
+    def law_code(self) -> int:
+        return LAW_CODES[self.law]
+
+
+def resolve(scene: Scene) -> Numerics:
+    P = scene.params
+    nm = scene.numerics
+    transit = P.L / P.c
+    ramp_time = nm.get("ramp_time", 2.0 * transit)
+    dt = nm.get("dt", max(ramp_time, transit) / 50.0)
+    t_end = nm.get("t_end", ramp_time + 400.0 * transit)
+    if dt > t_end:
+        raise SceneError(f"numerics.dt: must be <= numerics.t_end = {t_end!r}, got {dt!r}")
+    if P.friction == "coulomb":
+        dv = abs(P.v - P.c)
+        vreg = nm.get("regularisation", 1e-4 * dv if dv > 0 else 1e-6 * P.c)
+        law, fs = nm.get("friction_law", "tanh"), P.fstar
+    else:
+        delta = nm.get("adhesion_layer", 1e-6 * P.L)
+        law, vreg = "linear", 1.0
+        fs = P.B / (P.c * delta)
+    if P.inertia:
+        omega1 = math.pi * P.B / (P.L * math.sqrt(P.rho * P.b1))
+        damping = nm.get("damping", 2.0 * omega1)
+    else:
+        damping = 0.0
+    return Numerics(
+        integrator=nm.get("integrator", "implicit"),
+        elements=nm.get("elements", DEFAULT_ELEMENTS),
+        grading=nm.get("grading", DEFAULT_GRADING),
+        dt=dt, t_end=t_end, ramp_time=ramp_time, law=law, vreg=vreg, fs=fs,
+        damping=damping, steady_tol=nm.get("steady_tol", 1e-6),
+        snapshot_interval=nm.get("snapshot_interval"),
+    )
+
+
+def build_grid(scene: Scene, num: Numerics) -> Grid:
+    P = scene.params
+    return make_grid(P.L, P.x1, P.x2, num.elements, num.grading)
+
+
+def pack(P: Params, num: Numerics, grid: Grid):
+    """Float and int parameter vectors for the kernels."""
+    prm = np.zeros(N_PRM)
+    prm[P_B], prm[P_A], prm[P_B2] = P.B, P.A, P.b2
+    prm[P_RHO], prm[P_I], prm[P_C], prm[P_HH] = P.rho, P.I, P.c, 0.5 * P.h
+    prm[P_DAMP], prm[P_FS], prm[P_VREG] = num.damping, num.fs, num.vreg
+    prm[P_DV], prm[P_TRAMP] = P.v - P.c, num.ramp_time
+    iprm = np.zeros(N_IPRM, dtype=np.int64)
+    iprm[I_LAW], iprm[I_J1], iprm[I_J2] = num.law_code, grid.j1, grid.j2
+    # the linear law's dual and primal forms coincide; saturating laws need the dual
+    iprm[I_DUAL] = int(has_dual(num.law_code) and num.law_code != LINEAR)
+    return prm, iprm
+
+
+def scales(P: Params):
+    """Force, moment, displacement and rotation scales (Newton norms, rates)."""
+    eps = abs(P.e0) if P.e0 != 0.0 else 1e-6
+    force = P.B * eps
+    return np.array([force, force * 0.5 * P.h, eps * P.L, eps])
+
+
+__all__ = ["Numerics", "resolve", "build_grid", "pack", "scales", "LINEAR"]

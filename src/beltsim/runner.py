@@ -1,0 +1,222 @@
+"""The run loop: compiled time stepping between Python-level checks.
+
+As in py-pde's controller, a compiled kernel advances the state over one check
+interval of simulated time; between intervals Python-level trackers record the
+history, take snapshots, test for steady state and for divergence, and update
+the progress bar.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import analytic
+from .errors import NumericalError
+from .integrators import FAILED, NONFINITE, Workspace, advance_implicit
+from .numerics import Numerics, build_grid, pack, resolve, scales
+from .scene import Scene
+from .solution import DiscreteSolution, compare
+from .steady import SteadyDetector
+
+GROWTH_LIMIT = 1e4  # |u| / (|e0| L) or |theta| / |e0| beyond this counts as divergence
+
+
+@dataclass
+class RunResult:
+    scene: Scene
+    numerics: Numerics
+    solution: DiscreteSolution
+    reference: analytic.AnalyticSolution | None
+    converged: bool
+    simulated_time: float
+    steps: int
+    wall_time: float
+    history: dict
+    reason: str | None = None
+    snapshots: dict = field(default_factory=dict)
+    newton_iterations: int = 0
+
+    @property
+    def failed(self) -> bool:
+        return self.reason is not None and not self.converged
+
+    def errors(self) -> dict | None:
+        if self.reference is None:
+            return None
+        return compare(self.solution, self.reference)
+
+    def summary(self) -> dict:
+        out = self.solution.summary()
+        out.update(converged=self.converged, simulated_time=self.simulated_time,
+                   steps=self.steps, wall_time=self.wall_time, reason=self.reason,
+                   elements=self.numerics.elements, integrator=self.numerics.integrator,
+                   error=self.errors())
+        return out
+
+
+class Simulation:
+    """A scene on its grid, from rest. ``run()`` steps it to steady state."""
+
+    def __init__(self, scene: Scene):
+        self.scene = scene
+        self.params = scene.params
+        self.numerics = resolve(scene)
+        self.grid = build_grid(scene, self.numerics)
+        self.prm, self.iprm = pack(self.params, self.numerics, self.grid)
+        self.scales = scales(self.params)
+        N = self.grid.n_elements
+        self.he, self.hb = self.grid.he, self.grid.hbar
+        self.u = np.zeros(N + 1)
+        self.theta = np.zeros(N + 1)
+        self.lam = np.zeros(N + 1)  # friction ratio g(v_rel / v_reg) at contact nodes
+        self.ud = np.zeros(N + 1)
+        self.td = np.zeros(N + 1)
+        self.t = 0.0
+        self.steps = 0
+        self.dt = self.numerics.dt
+        self.work = Workspace(N)
+
+    # ------------------------------------------------------------------
+    def rate(self) -> float:
+        """Largest local rate, relative to c |e0| (per unit length for theta)."""
+        P = self.params
+        v = P.c * self.scales[3]
+        return float(max(np.max(np.abs(self.ud)), P.L * np.max(np.abs(self.td))) / v)
+
+    def state(self) -> DiscreteSolution:
+        return DiscreteSolution(self.params, self.grid, self.u, self.theta, self.work.fnode,
+                                self.numerics.law_code, self.numerics.fs)
+
+    def advance(self, t_stop: float, max_steps: int = 10**9):
+        """Step until t >= t_stop; raises NumericalError on failure."""
+        num = self.numerics
+        status, t, dt, steps = advance_implicit(
+            self.u, self.theta, self.lam, self.ud, self.td, self.t, t_stop, self.dt, num.dt, max_steps,
+            self.he, self.hb, self.prm, self.iprm, self.scales, num.newton_tol,
+            num.newton_max_it, *self.work.arrays())
+        self.t, self.dt, self.steps = t, dt, self.steps + steps
+        if status == FAILED:
+            raise NumericalError(
+                f"Newton iteration failed at t = {t:.6g} s even with the step cut to "
+                f"dt = {dt:.3g} s (residual norm {self.work.stats[3]:.3g})", t=t,
+                quantity="newton")
+        if status == NONFINITE:
+            raise NumericalError(f"non-finite displacement or rotation at t = {t:.6g} s",
+                                 t=t, quantity="u/theta")
+        self._check_growth()
+
+    def _check_growth(self):
+        s = self.scales
+        gu = np.max(np.abs(self.u)) / s[2]
+        gt = np.max(np.abs(self.theta)) / s[3]
+        if gu > GROWTH_LIMIT or gt > GROWTH_LIMIT:
+            q, g = ("u", gu) if gu >= gt else ("theta", gt)
+            raise NumericalError(
+                f"{q} grew without bound at t = {self.t:.6g} s ({g:.3g} times its scale)",
+                t=self.t, quantity=q)
+
+    # ------------------------------------------------------------------
+    def run(self, progress: bool = False, raise_on_failure: bool = True,
+            snapshot_interval: float | None = None) -> RunResult:
+        """Run from the current state until steady (or t_end); compare with the analytic state."""
+        num, P = self.numerics, self.params
+        transit = P.L / P.c
+        window = transit
+        check = window / 4.0
+        snap_dt = snapshot_interval or num.snapshot_interval
+        if snap_dt:
+            check = min(check, snap_dt)
+        detector = SteadyDetector(num.steady_tol, window, t_min=num.ramp_time)
+        fscale = P.B * self.scales[3] * 1e-3
+        hist_t, hist_f, hist_r = [], [], []
+        snaps = _Snapshots(self) if snap_dt else None
+        if snaps is not None:
+            snaps.take()
+        bar = _progress(progress, num.t_end)
+        converged, reason = False, None
+        start = time.perf_counter()
+        try:
+            while self.t < num.t_end:
+                self.advance(min(self.t + check, num.t_end))
+                total = float(self.work.fnode.sum())
+                rate = self.rate()
+                hist_t.append(self.t)
+                hist_f.append(total)
+                hist_r.append(rate)
+                if snaps is not None and self.t >= snaps.next_time(snap_dt):
+                    snaps.take()
+                if bar is not None:
+                    bar.update(min(self.t, num.t_end) - bar.n)
+                    bar.set_postfix(rate=f"{rate:.2e}", friction=f"{total:.5g}", refresh=False)
+                if detector.update(self.t, rate, total, fscale):
+                    converged = True
+                    break
+        except NumericalError as exc:
+            reason = str(exc)
+            if raise_on_failure:
+                raise
+        finally:
+            if bar is not None:
+                bar.close()
+        wall = time.perf_counter() - start
+        if snaps is not None and (not snaps.times or snaps.times[-1] < self.t):
+            snaps.take()
+        if reason is None and not converged:
+            reason = (f"not steady by t_end = {num.t_end:.6g} s (rate {hist_r[-1]:.3g}, "
+                      f"friction change {detector.change:.3g} per window; tolerance "
+                      f"{num.steady_tol:.3g})")
+        try:
+            ref = analytic.solve(self.scene)
+        except analytic.NoSolutionError:
+            ref = None
+        return RunResult(
+            scene=self.scene, numerics=num, solution=self.state(), reference=ref,
+            converged=converged, simulated_time=self.t, steps=self.steps, wall_time=wall,
+            history={"t": np.array(hist_t), "total_friction": np.array(hist_f),
+                     "rate": np.array(hist_r)},
+            reason=reason, snapshots=snaps.arrays() if snaps is not None else {},
+            newton_iterations=int(self.work.stats[0]))
+
+
+class _Snapshots:
+    """States at (about) every snapshot interval of simulated time."""
+
+    def __init__(self, sim: Simulation):
+        self.sim = sim
+        self.times, self.u, self.theta, self.fnode = [], [], [], []
+
+    def next_time(self, interval):
+        return (self.times[-1] if self.times else 0.0) + interval * (1 - 1e-9)
+
+    def take(self):
+        s = self.sim
+        self.times.append(s.t)
+        self.u.append(s.u.copy())
+        self.theta.append(s.theta.copy())
+        self.fnode.append(s.work.fnode.copy())
+
+    def arrays(self):
+        return {"t": np.array(self.times), "u": np.array(self.u),
+                "theta": np.array(self.theta), "fnode": np.array(self.fnode)}
+
+
+def _progress(enabled, total):
+    if not enabled:
+        return None
+    import sys
+
+    from tqdm import tqdm
+    if not sys.stderr.isatty():
+        return None
+    return tqdm(total=total, unit="s", unit_scale=True, desc="simulated", leave=False,
+                bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s [{elapsed}<{remaining}]{postfix}")
+
+
+def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,
+        snapshot_interval: float | None = None) -> RunResult:
+    """Run a scene from rest to steady state (API entry point)."""
+    return Simulation(scene).run(progress=progress, raise_on_failure=raise_on_failure,
+                                 snapshot_interval=snapshot_interval)

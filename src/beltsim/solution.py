@@ -1,0 +1,134 @@
+"""A discrete state read as a solution: fields, friction totals, errors.
+
+How the analytic quantities are read off the discrete state:
+
+* the nodal friction forces F_j (N) are the element tractions lumped on the
+  downstream node; ``total_friction`` is their sum;
+* perfect adhesion: the concentrated force is the force of the last contact
+  element (ending at x2) minus the distributed traction there, linearly
+  extrapolated from the two elements upstream; the rest is distributed;
+* stick and slip: an element slides when |f| >= 0.99 f* (1 - 1e-12 for the ramp
+  law); ``slip_start`` x* is the upstream end of the run of sliding elements
+  that ends at x2 (x2 itself if the last element sticks); the friction of
+  sliding elements is ``slip_friction``, the rest ``stick_friction``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .analytic import AnalyticSolution
+from .friction import saturation
+from .grid import Grid
+from .scene import Params
+
+
+class DiscreteSolution:
+    def __init__(self, params: Params, grid: Grid, u, theta, fnode, law_code, fs):
+        self.params = params
+        self.grid = grid
+        self.u = np.asarray(u, dtype=float).copy()
+        self.theta = np.asarray(theta, dtype=float).copy()
+        self.fnode = np.asarray(fnode, dtype=float).copy()
+        self.model = "stick" if params.friction == "stick" else "slip"
+        self._law = law_code
+        self._fs = fs
+
+    @property
+    def x(self):
+        return self.grid.x
+
+    @property
+    def traction(self) -> np.ndarray:
+        """Element traction f (N/m) at each node (of the element upstream), 0 off contact."""
+        f = np.zeros_like(self.fnode)
+        he = self.grid.he
+        f[1:] = self.fnode[1:] / he
+        return f
+
+    def fields(self) -> dict:
+        """Nodal fields with the analytic header: strain and moment averaged from elements."""
+        P, he = self.params, self.grid.he
+        eps_e = np.diff(self.u) / he
+        kap_e = np.diff(self.theta) / he
+        strain = np.concatenate([[eps_e[0]], 0.5 * (eps_e[1:] + eps_e[:-1]), [eps_e[-1]]])
+        kappa = np.concatenate([[kap_e[0]], 0.5 * (kap_e[1:] + kap_e[:-1]), [kap_e[-1]]])
+        return {"u": self.u, "theta": self.theta, "strain": strain,
+                "tension": P.b1 * strain, "moment": P.a * kappa, "friction": self.traction}
+
+    # totals ---------------------------------------------------------
+    @property
+    def total_friction(self) -> float:
+        return float(self.fnode.sum())
+
+    def _sliding(self):
+        """Boolean per node: the element upstream of the node slides."""
+        g = np.abs(self.fnode[1:] / self.grid.he) / self._fs
+        s = np.zeros_like(self.fnode, dtype=bool)
+        s[1:] = g >= saturation(self._law)
+        s[: self.grid.j1 + 1] = False
+        s[self.grid.j2 + 1:] = False
+        return s
+
+    @property
+    def slip_start(self) -> float:
+        s = self._sliding()
+        j = self.grid.j2
+        while j > self.grid.j1 and s[j]:
+            j -= 1
+        return float(self.grid.x[j])
+
+    @property
+    def concentrated_force(self) -> float:
+        g, f = self.grid, self.traction
+        j2 = g.j2
+        xm = 0.5 * (g.x[1:] + g.x[:-1])  # element midpoints; element e ends at node e+1
+        e_last, e1, e2 = j2 - 1, j2 - 2, j2 - 3
+        if e2 < g.j1:
+            f_ext = f[j2 - 1]
+        else:
+            slope = (f[e1 + 1] - f[e2 + 1]) / (xm[e1] - xm[e2])
+            f_ext = f[e1 + 1] + slope * (xm[e_last] - xm[e1])
+        return float(self.fnode[j2] - f_ext * g.he[e_last])
+
+    def summary(self) -> dict:
+        total = self.total_friction
+        if self.model == "stick":
+            conc = self.concentrated_force
+            return {"model": "stick", "inertia": self.params.inertia, "total_friction": total,
+                    "concentrated_force": conc, "distributed_friction": total - conc,
+                    "stick_friction": None, "slip_friction": None, "slip_start": None}
+        s = self._sliding()
+        slip = float(self.fnode[s].sum())
+        return {"model": "slip", "inertia": self.params.inertia, "total_friction": total,
+                "concentrated_force": None, "distributed_friction": None,
+                "stick_friction": total - slip, "slip_friction": slip,
+                "slip_start": self.slip_start}
+
+
+def compare(sim: DiscreteSolution, ref: AnalyticSolution) -> dict:
+    """Errors of a discrete state against the analytic solution of the same scene.
+
+    Relative errors for total friction, u and theta (max over the grid nodes,
+    relative to the analytic field's max), the concentrated force (stick), and
+    the absolute error of the slip start in metres (slip).
+    """
+    a = ref.fields(sim.x)
+
+    def rel_field(name):
+        scale = np.max(np.abs(a[name]))
+        diff = np.max(np.abs(getattr(sim, name) - a[name]))
+        return float(diff / scale) if scale > 0 else float(diff)
+
+    def rel(x, y):
+        return abs(x - y) / abs(y) if y != 0 else abs(x - y)
+
+    out = {"total_friction": rel(sim.total_friction, ref.total_friction),
+           "u": rel_field("u"), "theta": rel_field("theta")}
+    if ref.model == "stick":
+        out["concentrated_force"] = rel(sim.concentrated_force, ref.concentrated_force)
+        out["slip_start"] = None
+    else:
+        out["concentrated_force"] = None
+        out["slip_start"] = abs(sim.slip_start - ref.x_star)
+    return out
