@@ -4,9 +4,10 @@ How the analytic quantities are read off the discrete state:
 
 * the nodal friction forces F_j (N) are the element tractions lumped on the
   downstream node; ``total_friction`` is their sum;
-* perfect adhesion: the concentrated force is the force of the last contact
-  element (ending at x2) minus the distributed traction there, linearly
-  extrapolated from the two elements upstream; the rest is distributed;
+* perfect adhesion: the concentrated force is what the last three contact
+  elements (ending at x2) carry beyond the distributed traction, which is
+  extrapolated linearly from the three elements upstream of them; the rest of
+  the total is distributed;
 * stick and slip: an element slides when |f| >= 0.99 f* (1 - 1e-12 for the ramp
   law); ``slip_start`` x* is the upstream end of the run of sliding elements
   that ends at x2 (x2 itself if the last element sticks); the friction of
@@ -21,6 +22,9 @@ from .analytic import AnalyticSolution
 from .friction import saturation
 from .grid import Grid
 from .scene import Params
+
+
+LAYER, FIT = 3, 3  # elements of the discrete force layer at x2, and of the smooth fit
 
 
 class DiscreteSolution:
@@ -80,16 +84,23 @@ class DiscreteSolution:
 
     @property
     def concentrated_force(self) -> float:
+        """Excess over a smooth traction in the last LAYER elements before x2.
+
+        The discrete force is not all on the last element: the element before it
+        carries a little of it too (a discrete layer of one or two elements), so the
+        smooth traction is fitted on the FIT elements upstream of that layer.
+        """
         g, f = self.grid, self.traction
-        j2 = g.j2
-        xm = 0.5 * (g.x[1:] + g.x[:-1])  # element midpoints; element e ends at node e+1
-        e_last, e1, e2 = j2 - 1, j2 - 2, j2 - 3
-        if e2 < g.j1:
-            f_ext = f[j2 - 1]
+        last = g.j2 - 1  # element index; element e ends at node e + 1
+        layer = np.arange(max(g.j1, last - LAYER + 1), last + 1)
+        fit = np.arange(max(g.j1, layer[0] - FIT), layer[0])
+        xm = 0.5 * (g.x[1:] + g.x[:-1])
+        if len(fit) >= 2:
+            coef = np.polyfit(xm[fit], f[fit + 1], 1)
+            smooth = np.polyval(coef, xm[layer])
         else:
-            slope = (f[e1 + 1] - f[e2 + 1]) / (xm[e1] - xm[e2])
-            f_ext = f[e1 + 1] + slope * (xm[e_last] - xm[e1])
-        return float(self.fnode[j2] - f_ext * g.he[e_last])
+            smooth = np.full(len(layer), f[fit + 1].mean() if len(fit) else 0.0)
+        return float(np.sum(self.fnode[layer + 1] - smooth * g.he[layer]))
 
     def summary(self) -> dict:
         total = self.total_friction
