@@ -63,6 +63,40 @@ def format_summary(summary: dict, title: str = "") -> str:
     return "\n".join(lines)
 
 
+def cmd_run(args):
+    from pathlib import Path
+
+    from .results import prepare_outdir, save_run
+    from .runner import run
+
+    scene = _scene(args)
+    out = prepare_outdir(args.out or Path("runs/out") / Path(args.scene).stem)
+    result = run(scene, progress=not args.quiet, raise_on_failure=False)
+    save_run(result, out)
+    summary = result.summary()
+    print(format_summary(summary, title=scene.title or args.scene))
+    print(format_run(summary))
+    print(f"wrote {out}/summary.json, fields.csv, history.csv")
+    if result.failed:
+        print(f"beltsim: numerical failure: {result.reason}", file=sys.stderr)
+        return 3
+    if not result.converged:
+        print(f"beltsim: warning: {result.reason}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def format_run(summary: dict) -> str:
+    lines = [f"  converged       {str(summary['converged']).lower()} after "
+             f"{summary['steps']} steps, t = {summary['simulated_time']:.4g} s, "
+             f"wall {summary['wall_time']:.3g} s"]
+    err = summary.get("error")
+    if err:
+        parts = [f"{k} {v:.2e}" for k, v in err.items() if v is not None]
+        lines.append("  error vs exact  " + ", ".join(parts) + " (slip_start in m)")
+    return "\n".join(lines)
+
+
 def build_parser():
     parser = _Parser(prog="beltsim", description="Belt-drive contact mechanics: analytic "
                      "steady solutions and transient Eulerian simulation.")
@@ -71,6 +105,12 @@ def build_parser():
     _add_scene_args(p)
     p.add_argument("--out", default="runs/out/analytic", help="output directory")
     p.set_defaults(func=cmd_analytic)
+
+    p = sub.add_parser("run", help="transient simulation from rest to steady state")
+    _add_scene_args(p)
+    p.add_argument("--out", default=None, help="output directory (default runs/out/SCENE)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_run)
     return parser
 
 

@@ -100,3 +100,23 @@ def read_csv(path) -> dict:
         header = fh.readline().strip().split(",")
     data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     return {name: data[:, i] for i, name in enumerate(header)}
+
+
+def save_run(result, out) -> list[Path]:
+    """Write a run's summary.json, fields.csv, history.csv and scene.toml into ``out``.
+
+    A failed run writes its summary (converged = false, the reason) and the
+    fields of the last good state, which hold no NaN by construction.
+    """
+    out = prepare_outdir(out)
+    sol = result.solution
+    paths = [
+        write_fields(out / "fields.csv", sol.x, sol.fields()),
+        write_csv(out / "history.csv", ("t", "total_friction", "rate"),
+                  [result.history["t"], result.history["total_friction"],
+                   result.history["rate"]]),
+        write_atomic(out / "scene.toml", result.scene.to_toml()),
+    ]
+    # the summary last: its presence means the other files are complete
+    paths.append(write_json(out / "summary.json", result.summary()))
+    return paths

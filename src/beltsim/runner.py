@@ -36,12 +36,10 @@ class RunResult:
     wall_time: float
     history: dict
     reason: str | None = None
+    failed: bool = False  # stopped on a numerical failure (else: converged or reached t_end)
     snapshots: dict = field(default_factory=dict)
     newton_iterations: int = 0
-
-    @property
-    def failed(self) -> bool:
-        return self.reason is not None and not self.converged
+    compile_time: float = 0.0
 
     def errors(self) -> dict | None:
         if self.reference is None:
@@ -51,7 +49,8 @@ class RunResult:
     def summary(self) -> dict:
         out = self.solution.summary()
         out.update(converged=self.converged, simulated_time=self.simulated_time,
-                   steps=self.steps, wall_time=self.wall_time, reason=self.reason,
+                   steps=self.steps, wall_time=self.wall_time, compile_time=self.compile_time,
+                   reason=self.reason,
                    elements=self.numerics.elements, integrator=self.numerics.integrator,
                    error=self.errors())
         return out
@@ -88,7 +87,13 @@ class Simulation:
 
     def state(self) -> DiscreteSolution:
         return DiscreteSolution(self.params, self.grid, self.u, self.theta, self.work.fnode,
-                                self.numerics.law_code, self.numerics.fs)
+                                self.numerics.law_code, self.numerics.fs, self.ud, self.td)
+
+    def warm_up(self) -> float:
+        """Compile (or load from numba's cache) the kernels; returns the seconds it took."""
+        start = time.perf_counter()
+        self.advance(self.t, max_steps=0)
+        return time.perf_counter() - start
 
     def advance(self, t_stop: float, max_steps: int = 10**9):
         """Step until t >= t_stop; raises NumericalError on failure."""
@@ -135,8 +140,9 @@ class Simulation:
         snaps = _Snapshots(self) if snap_dt else None
         if snaps is not None:
             snaps.take()
+        compile_time = self.warm_up()
         bar = _progress(progress, num.t_end)
-        converged, reason = False, None
+        converged, reason, failed = False, None, False
         start = time.perf_counter()
         try:
             while self.t < num.t_end:
@@ -155,7 +161,7 @@ class Simulation:
                     converged = True
                     break
         except NumericalError as exc:
-            reason = str(exc)
+            reason, failed = str(exc), True
             if raise_on_failure:
                 raise
         finally:
@@ -177,8 +183,9 @@ class Simulation:
             converged=converged, simulated_time=self.t, steps=self.steps, wall_time=wall,
             history={"t": np.array(hist_t), "total_friction": np.array(hist_f),
                      "rate": np.array(hist_r)},
-            reason=reason, snapshots=snaps.arrays() if snaps is not None else {},
-            newton_iterations=int(self.work.stats[0]))
+            reason=reason, failed=failed,
+            snapshots=snaps.arrays() if snaps is not None else {},
+            newton_iterations=int(self.work.stats[0]), compile_time=compile_time)
 
 
 class _Snapshots:

@@ -28,11 +28,15 @@ LAYER, FIT = 3, 3  # elements of the discrete force layer at x2, and of the smoo
 
 
 class DiscreteSolution:
-    def __init__(self, params: Params, grid: Grid, u, theta, fnode, law_code, fs):
+    def __init__(self, params: Params, grid: Grid, u, theta, fnode, law_code, fs, ud=None,
+                 td=None):
         self.params = params
         self.grid = grid
         self.u = np.asarray(u, dtype=float).copy()
         self.theta = np.asarray(theta, dtype=float).copy()
+        # local time derivatives of the state (zero for a steady solve)
+        self.ud = np.zeros_like(self.u) if ud is None else np.asarray(ud, dtype=float).copy()
+        self.td = np.zeros_like(self.u) if td is None else np.asarray(td, dtype=float).copy()
         self.fnode = np.asarray(fnode, dtype=float).copy()
         self.model = "stick" if params.friction == "stick" else "slip"
         self._law = law_code
