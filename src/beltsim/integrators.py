@@ -15,7 +15,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .model import I_DUAL, assemble, block_solve, update_multipliers
+from .friction import law
+from .model import (I_DUAL, I_J1, I_J2, I_LAW, P_A, P_B, P_B2, P_C, P_DAMP, P_DV, P_FS, P_HH, P_I,
+                    P_RHO, P_TRAMP, P_VREG, assemble, block_solve, ramp, update_multipliers)
 
 # status codes of advance_implicit
 OK, FAILED, NONFINITE = 0, 1, 2
@@ -194,7 +196,186 @@ def advance_implicit(u, th, lam, ud, td, t, t_stop, dt, dt_nominal, max_steps, h
 
 @njit(cache=True)
 def solve_steady(u, th, lam, he, hb, prm, iprm, scales, tol, max_it, uo, tho, udo, tdo,
-                 R, Lb, Db, Ub, C, dx, u_try, th_try, fnode, rl, sg, stats):
-    """Newton on the discrete steady equations (inv_dt = 0) from the given state."""
-    return newton(u, th, lam, uo, tho, udo, tdo, 0.0, 1e300, he, hb, prm, iprm, scales, tol,
+                 R, Lb, Db, Ub, C, dx, u_try, th_try, fnode, rl, sg, stats, t):
+    """Newton on the discrete steady equations (inv_dt = 0) from the given state.
+
+    t sets the surface speed through the ramp (continuation).
+    """
+    return newton(u, th, lam, uo, tho, udo, tdo, 0.0, t, he, hb, prm, iprm, scales, tol,
                   max_it, R, Lb, Db, Ub, C, dx, u_try, th_try, fnode, rl, sg, stats)
+
+
+# ---------------------------------------------------------------------------
+# Explicit scheme (inertial scenes)
+#
+# Staggered leapfrog: u, theta at whole steps, their local velocities v, w at half
+# steps. Elastic, shear and damping forces use the state at step n; the gyroscopic
+# term 2 c u_xt is upwind in space, explicit in time (central in space it grows at
+# any step: the explicit skew term has |amplification| = sqrt(1 + (g dt)^2)); at
+# steady state it vanishes, so the steady state is the implicit scheme's. Friction
+# is implicit in the node's own velocity (one monotone scalar equation per contact
+# node), so its stiffness f*/v_reg sets no step limit; the transport part of the
+# slip velocity uses step n and obeys the CFL condition of the waves.
+
+
+SMALL_STEP = 1e-5  # relative Newton step below which the friction solve stops
+# fast-math flags that keep NaN and inf semantics (a failing run must still show them)
+SAFE_FASTMATH = {"reassoc", "contract", "arcp"}
+
+
+@njit(cache=True)
+def _friction_scalar(code, s_pred, kappa, s0):
+    """Solve s + kappa g(s) = s_pred; returns (s, g(s)).
+
+    g is odd, increasing and |g| <= 1 (unless linear), so the root lies in
+    [s_pred - kappa, s_pred + kappa]. Newton from s0 (the node's value at the previous
+    step, so one or two iterations in a settled state), safeguarded by bisection.
+    """
+    if code == 0:  # linear law: closed form
+        s = s_pred / (1.0 + kappa)
+        return s, s
+    if code == 3:  # ramp
+        if abs(s_pred) <= 1.0 + kappa:
+            s = s_pred / (1.0 + kappa)
+            return s, s
+        return (s_pred - kappa, 1.0) if s_pred > 0 else (s_pred + kappa, -1.0)
+    lo, hi = s_pred - kappa, s_pred + kappa
+    s = s0 if lo < s0 < hi else s_pred / (1.0 + kappa)
+    tol = 1e-13 * (abs(s_pred) + kappa)
+    g = 0.0
+    for _ in range(80):
+        g, gp = law(code, s)
+        r = s + kappa * g - s_pred
+        ds = -r / (1.0 + kappa * gp)
+        if abs(ds) <= SMALL_STEP * (1.0 + abs(s)) and lo < s + ds < hi:
+            # g linearised over the step: error g'' ds^2 / 2 < 1e-10, and none at a
+            # fixed point; in a settled run this is the first iteration (ds ~ 1e-7)
+            return s + ds, g + gp * ds
+        if abs(r) <= tol:
+            return s, g
+        if r > 0.0:
+            hi = s
+        else:
+            lo = s
+        s_new = s + ds
+        if not (lo < s_new < hi):
+            s_new = 0.5 * (lo + hi)
+        s = s_new
+    return s, g
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH)
+def advance_explicit(u, th, v, w, sfr, t, t_stop, dt, max_steps, he, hb, prm, iprm, fnode):
+    """Explicit steps from t until t >= t_stop (or max_steps). Returns (t, steps).
+
+    v, w: local velocities (half steps); sfr: each contact node's last friction
+    argument v_rel / v_reg, the warm start of its scalar solve. The wave, shear,
+    gyroscopic and damping update is one branch-free pass over precomputed
+    coefficients into new velocity buffers; friction then corrects the contact nodes.
+    """
+    N = u.shape[0] - 1
+    B, A, b2 = prm[P_B], prm[P_A], prm[P_B2]
+    rho, I, c, hh = prm[P_RHO], prm[P_I], prm[P_C], prm[P_HH]
+    damp, fs, vreg = prm[P_DAMP], prm[P_FS], prm[P_VREG]
+    code, j1, j2 = iprm[I_LAW], iprm[I_J1], iprm[I_J2]
+    ar = np.zeros(N + 1)
+    al = np.zeros(N + 1)
+    br = np.zeros(N + 1)
+    bl = np.zeros(N + 1)
+    gl = np.zeros(N + 1)
+    kap = np.zeros(N + 1)
+    fm = np.zeros(N + 1)
+    fi = np.zeros(N + 1)
+    ch = np.zeros(N + 1)
+    fh = np.zeros(N + 1)
+    ivreg = 1.0 / vreg
+    for j in range(1, N):
+        m, mi = rho * hb[j], I * hb[j]
+        ar[j] = dt * B / (m * he[j])
+        al[j] = dt * B / (m * he[j - 1])
+        br[j] = dt * A / (mi * he[j])
+        bl[j] = dt * A / (mi * he[j - 1])
+        gl[j] = 2.0 * c * dt / he[j - 1]  # upwind gyroscopic term
+        fm[j] = dt / m
+        fi[j] = dt * hh / mi
+        kap[j] = dt * he[j - 1] * fs * (1.0 / m + hh * hh / mi) / vreg
+        ch[j] = c / he[j - 1]
+        fh[j] = he[j - 1] * fs
+    keep = 1.0 - dt * damp
+    spring = dt * b2 / I
+    vn = v.copy()
+    wn = w.copy()
+    steps = 0
+    while t < t_stop and steps < max_steps:
+        target = prm[P_DV] * ramp(t + 0.5 * dt, prm[P_TRAMP])
+        for j in range(1, N):
+            vn[j] = (keep * v[j] - gl[j] * (v[j] - v[j - 1]) + ar[j] * (u[j + 1] - u[j])
+                     - al[j] * (u[j] - u[j - 1]))
+            wn[j] = (keep * w[j] - gl[j] * (w[j] - w[j - 1]) + br[j] * (th[j + 1] - th[j])
+                     - bl[j] * (th[j] - th[j - 1]) - spring * th[j])
+        ub_l = u[j1] + hh * th[j1]
+        for j in range(j1 + 1, j2 + 1):
+            ub = u[j] + hh * th[j]
+            s_pred = (vn[j] + hh * wn[j] + ch[j] * (ub - ub_l) - target) * ivreg
+            ub_l = ub
+            sj, g = _friction_scalar(code, s_pred, kap[j], sfr[j])
+            sfr[j] = sj
+            F = -fh[j] * g
+            fnode[j] = F
+            vn[j] += fm[j] * F
+            wn[j] += fi[j] * F
+        for j in range(1, N):
+            u[j] += dt * vn[j]
+            th[j] += dt * wn[j]
+        v, vn = vn, v
+        w, wn = wn, w
+        t += dt
+        steps += 1
+    if steps % 2 == 1:  # the caller's arrays hold the buffers of the previous step
+        vn[:] = v
+        wn[:] = w
+    return t, steps
+
+
+def explicit_amplification(params, h, dt, damping):
+    """Largest von Neumann amplification of the explicit scheme on elements of size h.
+
+    Both fields: the axial one (wave speed sqrt(b1/rho)) and the rotation (sqrt(a/I)
+    with the shear term b2/I); the upwind gyroscopic term and the damping included.
+    """
+    kh = np.linspace(1e-4, np.pi, 2000)
+    worst = 0.0
+    P = params
+    for stiff, inertia, spring in ((P.B, P.rho, 0.0), (P.A, P.I, P.b2)):
+        G = 2.0 * P.c * (1.0 - np.exp(-1j * kh)) / h
+        w2 = (stiff / inertia) * (2.0 - 2.0 * np.cos(kh)) / h**2 + spring / inertia
+        # amplification matrix of (u^n, v^{n-1/2}): [[1 - dt^2 w2, dt a], [-dt w2, a]];
+        # its discriminant from p - s = dt (G + d) - dt^2 w2 and q r = -dt^2 w2 a, with
+        # no cancellation at small dt (tr^2/4 - det would lose it all)
+        a = 1.0 - dt * (G + damping)
+        half_tr = 0.5 * (1.0 - dt * dt * w2 + a)
+        disc = np.sqrt((0.5 * (dt * (G + damping) - dt * dt * w2)) ** 2 - dt * dt * w2 * a
+                       + 0j)
+        lam = np.maximum(np.abs(half_tr + disc), np.abs(half_tr - disc))
+        worst = max(worst, float(lam.max()))
+    return worst
+
+
+def explicit_stable_dt(params, h_min, damping):
+    """The largest step with amplification <= 1 on the smallest element (bisection).
+
+    Bounded by the CFL step h_min / (c + max characteristic speed); returns 0 when no
+    step is stable (the rotation equation needs some damping: see the module notes).
+    """
+    P = params
+    speed = P.c + max(np.sqrt(P.b1 / P.rho), np.sqrt(P.a / P.I))
+    hi = 2.0 * h_min / speed
+    lo = 0.0
+    tol = 1e-12
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if explicit_amplification(P, h_min, mid, damping) <= 1.0 + tol:
+            lo = mid
+        else:
+            hi = mid
+    return lo

@@ -22,6 +22,7 @@ Defaults (all overridable in [numerics]):
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -95,6 +96,31 @@ def resolve(scene: Scene) -> Numerics:
 def build_grid(scene: Scene, num: Numerics) -> Grid:
     P = scene.params
     return make_grid(P.L, P.x1, P.x2, num.elements, num.grading)
+
+
+EXPLICIT_SAFETY = 0.9  # default explicit step as a fraction of the stability limit
+
+
+def with_explicit_step(scene: Scene, num: Numerics, grid: Grid) -> Numerics:
+    """Set the explicit step from the stability limit; refuse a requested step above it."""
+    from .integrators import explicit_stable_dt
+
+    P = scene.params
+    limit = explicit_stable_dt(P, grid.h_min, num.damping)
+    cfl = grid.h_min / (P.c + max(math.sqrt(P.b1 / P.rho), math.sqrt(P.a / P.I)))
+    if limit < 0.05 * cfl:
+        raise SceneError(
+            f"numerics.damping: the explicit scheme is unstable with damping = "
+            f"{num.damping:.6g} 1/s on this grid (its explicit gyroscopic term in the rotation "
+            f"equation needs damping); use the default damping or the implicit integrator")
+    requested = scene.numerics.get("dt")
+    if requested is not None and requested > limit:
+        raise SceneError(
+            f"numerics.dt: {requested:.6g} s exceeds the explicit stability limit "
+            f"{limit:.6g} s (characteristic speeds c + sqrt(b1/rho), c + sqrt(a/I) on the "
+            f"smallest element, {grid.h_min:.3g} m, with the gyroscopic and shear terms)")
+    dt = requested if requested is not None else EXPLICIT_SAFETY * limit
+    return dataclasses.replace(num, dt=dt)
 
 
 def pack(P: Params, num: Numerics, grid: Grid):

@@ -15,8 +15,10 @@ import numpy as np
 
 from . import analytic
 from .errors import NumericalError
-from .integrators import FAILED, NONFINITE, Workspace, advance_implicit
-from .numerics import Numerics, build_grid, pack, resolve, scales
+from .integrators import (FAILED, NONFINITE, Workspace, advance_explicit, advance_implicit,
+                          solve_steady)
+from .model import P_TRAMP
+from .numerics import Numerics, build_grid, pack, resolve, scales, with_explicit_step
 from .scene import Scene
 from .solution import DiscreteSolution, compare
 from .steady import SteadyDetector
@@ -64,13 +66,17 @@ class Simulation:
         self.params = scene.params
         self.numerics = resolve(scene)
         self.grid = build_grid(scene, self.numerics)
+        if self.numerics.integrator == "explicit":
+            self.numerics = with_explicit_step(scene, self.numerics, self.grid)
         self.prm, self.iprm = pack(self.params, self.numerics, self.grid)
         self.scales = scales(self.params)
         N = self.grid.n_elements
         self.he, self.hb = self.grid.he, self.grid.hbar
         self.u = np.zeros(N + 1)
         self.theta = np.zeros(N + 1)
-        self.lam = np.zeros(N + 1)  # friction ratio g(v_rel / v_reg) at contact nodes
+        # contact nodes: friction ratio g(v_rel / v_reg) (implicit), or the argument
+        # v_rel / v_reg itself (explicit: the warm start of the per-node friction solve)
+        self.lam = np.zeros(N + 1)
         self.ud = np.zeros(N + 1)
         self.td = np.zeros(N + 1)
         self.t = 0.0
@@ -92,12 +98,29 @@ class Simulation:
     def warm_up(self) -> float:
         """Compile (or load from numba's cache) the kernels; returns the seconds it took."""
         start = time.perf_counter()
-        self.advance(self.t, max_steps=0)
+        if self.numerics.integrator == "steady":
+            w, z = self.work, np.zeros_like(self.u)
+            solve_steady(self.u, self.theta, self.lam, self.he, self.hb, self.prm, self.iprm,
+                         self.scales, 1.0, 0, z, z, z, z, w.R, w.Lb, w.Db, w.Ub, w.C, w.dx,
+                         w.u_try, w.th_try, w.fnode, w.rl, w.sg, w.stats, 0.0)
+            w.stats[:] = 0.0
+        else:
+            self.advance(self.t, max_steps=0)
         return time.perf_counter() - start
 
     def advance(self, t_stop: float, max_steps: int = 10**9):
         """Step until t >= t_stop; raises NumericalError on failure."""
         num = self.numerics
+        if num.integrator == "explicit":
+            t, steps = advance_explicit(self.u, self.theta, self.ud, self.td, self.lam, self.t,
+                                        t_stop, num.dt, max_steps, self.he, self.hb, self.prm,
+                                        self.iprm, self.work.fnode)
+            self.t, self.steps = t, self.steps + steps
+            if not (np.all(np.isfinite(self.u)) and np.all(np.isfinite(self.theta))):
+                raise NumericalError(f"non-finite displacement or rotation at t = {t:.6g} s",
+                                     t=t, quantity="u/theta")
+            self._check_growth()
+            return
         status, t, dt, steps = advance_implicit(
             self.u, self.theta, self.lam, self.ud, self.td, self.t, t_stop, self.dt, num.dt, max_steps,
             self.he, self.hb, self.prm, self.iprm, self.scales, num.newton_tol,
@@ -128,6 +151,8 @@ class Simulation:
             snapshot_interval: float | None = None) -> RunResult:
         """Run from the current state until steady (or t_end); compare with the analytic state."""
         num, P = self.numerics, self.params
+        if num.integrator == "steady":
+            return self._run_steady(raise_on_failure)
         transit = P.L / P.c
         window = transit
         check = window / 4.0
@@ -186,6 +211,82 @@ class Simulation:
             reason=reason, failed=failed,
             snapshots=snaps.arrays() if snaps is not None else {},
             newton_iterations=int(self.work.stats[0]), compile_time=compile_time)
+
+
+    def solve_steady(self):
+        """Newton on the discrete steady equations, with continuation in v - c.
+
+        The surface speed goes from c to v through the same smooth ramp as a run,
+        in stages that double after a success and shrink fourfold after a failure.
+        Returns the number of stages; raises NumericalError when the stage size
+        falls below 1e-6 of the full mismatch.
+        """
+        num = self.numerics
+        w = self.work
+        self.prm[P_TRAMP] = 1.0  # ramp(s, 1) is the continuation parameter
+        s_done, ds, stages = 0.0, 1.0, 0
+        zeros = np.zeros_like(self.u)
+        try:
+            while s_done < 1.0:
+                s = min(1.0, s_done + ds)
+                u0, th0, lam0 = self.u.copy(), self.theta.copy(), self.lam.copy()
+                self.prm[P_TRAMP] = 1.0
+                ok = solve_steady(self.u, self.theta, self.lam, self.he, self.hb, self.prm,
+                                  self.iprm, self.scales, num.newton_tol, 4 * num.newton_max_it,
+                                  zeros, zeros, zeros, zeros, w.R, w.Lb, w.Db, w.Ub, w.C, w.dx,
+                                  w.u_try, w.th_try, w.fnode, w.rl, w.sg, w.stats,
+                                  _stage_time(s))
+                stages += 1
+                if ok:
+                    s_done, ds = s, 2.0 * ds
+                else:
+                    self.u[:], self.theta[:], self.lam[:] = u0, th0, lam0
+                    ds *= 0.25
+                    if ds < 1e-6:
+                        raise NumericalError(
+                            f"steady Newton iteration failed at {100 * s_done:.4g}% of the "
+                            f"speed mismatch (continuation step below 1e-6)", t=0.0,
+                            quantity="newton")
+        finally:
+            self.prm[P_TRAMP] = num.ramp_time
+        return stages
+
+    def _run_steady(self, raise_on_failure):
+        compile_time = self.warm_up()
+        start = time.perf_counter()
+        reason, failed = None, False
+        stages = 0
+        try:
+            stages = self.solve_steady()
+        except NumericalError as exc:
+            reason, failed = str(exc), True
+            if raise_on_failure:
+                raise
+        wall = time.perf_counter() - start
+        try:
+            ref = analytic.solve(self.scene)
+        except analytic.NoSolutionError:
+            ref = None
+        return RunResult(
+            scene=self.scene, numerics=self.numerics, solution=self.state(), reference=ref,
+            converged=not failed, simulated_time=0.0, steps=stages, wall_time=wall,
+            history={"t": np.zeros(0), "total_friction": np.zeros(0), "rate": np.zeros(0)},
+            reason=reason, failed=failed, newton_iterations=int(self.work.stats[0]),
+            compile_time=compile_time)
+
+
+def _stage_time(s):
+    """The ramp time at which ramp(t, 1) = s (inverse of the smoothstep)."""
+    if s >= 1.0:
+        return 1.0
+    lo, hi = 0.0, 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if mid**3 * (10 - 15 * mid + 6 * mid * mid) < s:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
 
 
 class _Snapshots:
