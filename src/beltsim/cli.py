@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .errors import BeltsimError, NumericalError
+from .errors import BeltsimError, NumericalError, UsageError
 
 
 class _Parser(argparse.ArgumentParser):
@@ -97,6 +97,74 @@ def format_run(summary: dict) -> str:
     return "\n".join(lines)
 
 
+def cmd_convergence(args):
+    from pathlib import Path
+
+    from . import plots, studies
+    from .results import prepare_outdir, write_csv
+
+    scene = _scene(args)
+    out = prepare_outdir(args.out or Path("runs/out") / f"convergence_{Path(args.scene).stem}")
+    ladder = _int_list(args.ladder, "--ladder")
+    schemes = args.schemes.split(",") if args.schemes else None
+    for s in schemes or ():
+        if s not in ("explicit", "implicit", "steady"):
+            raise UsageError(f"--schemes: unknown scheme {s!r} (explicit, implicit, steady)")
+    cols = ("scheme", "elements", "h_min", "dt", "steps", "wall_time", "compile_time",
+            "converged") + tuple(f"error_{k}" for k in studies.ERROR_KEYS)
+    print("  ".join(f"{c:>12s}" for c in cols))
+
+    def show(row):
+        print("  ".join(_cell(row[c]) for c in cols), flush=True)
+    rows = studies.convergence(scene, ladder, schemes, progress=show)
+    write_csv(out / "convergence.csv", cols,
+              [[_num(r[c]) for r in rows] for c in cols], text_columns={"scheme"})
+    plots.error_vs_runtime(rows, out / "error_vs_runtime.png",
+                           title=f"{scene.title or args.scene}")
+    print("observed order in the grid size (successive grids; least-squares fit):")
+    for key in studies.ERROR_KEYS:
+        for scheme, o in studies.observed_orders(rows, key).items():
+            pairs = ", ".join(f"{p:.2f}" for p in o["pairs"])
+            print(f"  {key:<20s} {scheme:<9s} {pairs}  (fit {o['fit']:.2f})")
+    print(f"wrote {out / 'convergence.csv'} and {out / 'error_vs_runtime.png'}")
+    return 0
+
+
+def cmd_bench(args):
+    from . import studies
+
+    result = studies.bench(args.scene, args.overrides, peer=not args.no_peer,
+                           cold=not args.no_cold)
+    print(studies.bench_json(result))
+    return 0
+
+
+def _int_list(text, name):
+    try:
+        vals = [int(v) for v in text.split(",")]
+    except ValueError:
+        raise UsageError(f"{name}: expected comma-separated whole numbers, got {text!r}") from None
+    if any(v < 6 for v in vals):
+        raise UsageError(f"{name}: every grid needs at least 6 elements")
+    return vals
+
+
+def _num(v):
+    if isinstance(v, bool):
+        return float(v)
+    return v
+
+
+def _cell(v):
+    if isinstance(v, str):
+        return f"{v:>12s}"
+    if isinstance(v, bool):
+        return f"{str(v).lower():>12s}"
+    if isinstance(v, int):
+        return f"{v:>12d}"
+    return f"{v:>12.4g}"
+
+
 def build_parser():
     parser = _Parser(prog="beltsim", description="Belt-drive contact mechanics: analytic "
                      "steady solutions and transient Eulerian simulation.")
@@ -111,6 +179,25 @@ def build_parser():
     p.add_argument("--out", default=None, help="output directory (default runs/out/SCENE)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("convergence", help="errors and run times of each scheme on a ladder "
+                       "of grids")
+    _add_scene_args(p)
+    p.add_argument("--out", default=None, help="output directory")
+    p.add_argument("--ladder", default="125,250,500,1000,2000",
+                   help="element counts (comma-separated)")
+    p.add_argument("--schemes", default=None,
+                   help="comma-separated subset of explicit,implicit,steady")
+    p.set_defaults(func=cmd_convergence)
+
+    p = sub.add_parser("bench", help="paper slip scene: ours against a solve_ivp peer, "
+                       "explicit kernel speed, cold start")
+    p.add_argument("scene", nargs="?", default="runs/paper_slip.toml")
+    p.add_argument("--set", dest="overrides", action="append", default=[],
+                   metavar="SECTION.KEY=VALUE")
+    p.add_argument("--no-peer", action="store_true", help="skip the solve_ivp peer")
+    p.add_argument("--no-cold", action="store_true", help="skip the cold-start run")
+    p.set_defaults(func=cmd_bench)
     return parser
 
 

@@ -24,3 +24,7 @@ class NumericalError(BeltsimError, RuntimeError):
         super().__init__(message)
         self.t = t
         self.quantity = quantity
+
+
+class UsageError(BeltsimError, ValueError):
+    """A command-line option has a bad value."""

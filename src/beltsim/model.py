@@ -212,8 +212,14 @@ def block_solve(Lb, Db, Ub, r, x, C):
 # numpy twins (tests and post-processing)
 
 
-def residual_numpy(u, th, uo, tho, udo, tdo, inv_dt, t, he, hb, prm, iprm):
-    """Vectorised twin of :func:`assemble` (residual and nodal friction only)."""
+def forces_numpy(u, th, ud, td, t, he, hb, prm, iprm):
+    """Nodal forces and moments of the semi-discrete model, all but the inertia terms.
+
+    Returns (force on u, moment on theta) at the interior nodes and the nodal
+    friction forces; with lumped masses m = rho hbar, m_I = I hbar the model reads
+    m u_tt = force, m_I theta_tt = moment. Vectorised twin of :func:`assemble`, and
+    the right-hand side of the method-of-lines system (the bench's peer).
+    """
     B, A, b2 = prm[P_B], prm[P_A], prm[P_B2]
     rho, I, c, hh = prm[P_RHO], prm[P_I], prm[P_C], prm[P_HH]
     damp, fs, vreg = prm[P_DAMP], prm[P_FS], prm[P_VREG]
@@ -221,23 +227,28 @@ def residual_numpy(u, th, uo, tho, udo, tdo, inv_dt, t, he, hb, prm, iprm):
     s = 1.0 if (tr <= 0 or t >= tr) else (0.0 if t <= 0 else (t / tr) ** 3 * (
         10 - 15 * (t / tr) + 6 * (t / tr) ** 2))
     code, j1, j2 = int(iprm[I_LAW]), int(iprm[I_J1]), int(iprm[I_J2])
-    ud = (u - uo) * inv_dt
-    td = (th - tho) * inv_dt
-    acc_u = (ud - udo) * inv_dt + damp * ud
-    acc_t = (td - tdo) * inv_dt + damp * td
-    eps = np.diff(u) / he
-    kap = np.diff(th) / he
     ub = u + hh * th
     F = np.zeros_like(u)
     j = np.arange(j1 + 1, j2 + 1)
-    vrel = (ub[j] - (uo[j] + hh * tho[j])) * inv_dt + c * (ub[j] - ub[j - 1]) / he[j - 1] \
-        - prm[P_DV] * s
-    g, _ = law_numpy(code, vrel / vreg)
-    F[j] = -he[j - 1] * fs * g
+    vrel = ud[j] + hh * td[j] + c * (ub[j] - ub[j - 1]) / he[j - 1] - prm[P_DV] * s
+    F[j] = -he[j - 1] * fs * law_numpy(code, vrel / vreg)[0]
     sl = slice(1, -1)
-    ru = (rho * hb[sl] * acc_u[sl] + rho * c * (ud[2:] - ud[:-2]) - B * np.diff(eps) - F[sl])
-    rt = (I * hb[sl] * acc_t[sl] + I * c * (td[2:] - td[:-2]) - A * np.diff(kap)
-          + b2 * hb[sl] * th[sl] - hh * F[sl])
+    fu = (B * np.diff(np.diff(u) / he) - rho * c * (ud[2:] - ud[:-2])
+          - damp * rho * hb[sl] * ud[sl] + F[sl])
+    ft = (A * np.diff(np.diff(th) / he) - b2 * hb[sl] * th[sl] - I * c * (td[2:] - td[:-2])
+          - damp * I * hb[sl] * td[sl] + hh * F[sl])
+    return fu, ft, F
+
+
+def residual_numpy(u, th, uo, tho, udo, tdo, inv_dt, t, he, hb, prm, iprm):
+    """Vectorised twin of :func:`assemble` (residual and nodal friction only)."""
+    rho, I = prm[P_RHO], prm[P_I]
+    ud = (u - uo) * inv_dt
+    td = (th - tho) * inv_dt
+    fu, ft, F = forces_numpy(u, th, ud, td, t, he, hb, prm, iprm)
+    sl = slice(1, -1)
+    ru = rho * hb[sl] * (ud[sl] - udo[sl]) * inv_dt - fu
+    rt = I * hb[sl] * (td[sl] - tdo[sl]) * inv_dt - ft
     return np.column_stack([ru, rt]), F
 
 

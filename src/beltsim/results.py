@@ -81,12 +81,17 @@ def write_json(path, obj) -> Path:
     return write_atomic(path, json.dumps(_jsonable(obj), indent=2) + "\n")
 
 
-def write_csv(path, header, columns) -> Path:
-    """Columns of equal length under a header, full double precision."""
-    cols = [np.asarray(c, dtype=float) for c in columns]
-    table = np.column_stack(cols) if cols else np.empty((0, 0))
+def write_csv(path, header, columns, text_columns=()) -> Path:
+    """Columns of equal length under a header, full double precision.
+
+    Columns named in ``text_columns`` are written as they are; numbers as repr()
+    (round-trips exactly), NaN as "nan".
+    """
+    cols = [list(c) if name in text_columns else [float(v) for v in np.asarray(c, dtype=float)]
+            for name, c in zip(header, columns)]
     lines = [",".join(header)]
-    lines += [",".join(repr(float(v)) for v in row) for row in table]
+    for row in zip(*cols):
+        lines.append(",".join(v if isinstance(v, str) else repr(v) for v in row))
     return write_atomic(path, "\n".join(lines) + "\n")
 
 

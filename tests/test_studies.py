@@ -1,0 +1,86 @@
+"""The convergence and bench commands run and give sane outputs (no timing asserted)."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+
+from beltsim import studies
+from beltsim.results import read_csv
+from beltsim.runner import Simulation
+from beltsim.scene import load_scene
+
+
+def _cli(*args, timeout=600):
+    return subprocess.run([sys.executable, "-m", "beltsim.cli", *args], capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def test_convergence_command_small_ladder(tmp_path):
+    proc = _cli("convergence", "runs/paper_slip.toml", "--ladder", "60,120,240", "--out",
+                str(tmp_path))
+    assert proc.returncode == 0, proc.stderr
+    table = read_csv_text(tmp_path / "convergence.csv")
+    assert [r["scheme"] for r in table] == ["explicit"] * 3 + ["implicit"] * 3 + ["steady"] * 3
+    assert all(r["converged"] == "1.0" for r in table)
+    for scheme in ("explicit", "implicit", "steady"):
+        errs = [float(r["error_total_friction"]) for r in table if r["scheme"] == scheme]
+        assert errs[0] > errs[1] > errs[2]  # refining shrinks the error
+        assert all(float(r["wall_time"]) > 0 for r in table if r["scheme"] == scheme)
+    assert (tmp_path / "error_vs_runtime.png").stat().st_size > 10_000
+    assert "observed order" in proc.stdout and "total_friction" in proc.stdout
+
+
+def read_csv_text(path):
+    lines = path.read_text().splitlines()
+    header = lines[0].split(",")
+    return [dict(zip(header, line.split(","))) for line in lines[1:]]
+
+
+def test_observed_orders_recover_a_known_rate():
+    rows = [{"scheme": "x", "converged": True, "h_min": h, "error_u": 3.0 * h**1.5}
+            for h in (0.1, 0.05, 0.025)]
+    o = studies.observed_orders(rows, "u")["x"]
+    np.testing.assert_allclose(o["pairs"], [1.5, 1.5])
+    assert abs(o["fit"] - 1.5) < 1e-12
+
+
+def test_peer_rhs_is_the_semi_discrete_model():
+    """The peer's right-hand side and the implicit residual describe one model: a
+    backward-Euler residual built from the peer's accelerations vanishes."""
+    sim = Simulation(load_scene("runs/paper_slip.toml", ["numerics.elements=40"]))
+    peer = studies.PeerSystem(sim)
+    rng = np.random.default_rng(0)
+    y = 1e-4 * rng.standard_normal(4 * peer.n)
+    f = peer.rhs(0.3, y)
+    n = peer.n
+    from beltsim.model import residual_numpy
+    dt = 1e-3
+    u, th, ud, td = (np.concatenate([[0], part, [0]]) for part in np.split(y, 4))
+    acc_u = np.concatenate([[0], f[2 * n:3 * n], [0]])
+    acc_t = np.concatenate([[0], f[3 * n:], [0]])
+    # choose the "old" state so that the backward-Euler velocities are ud, td and the
+    # accelerations are the peer's
+    uo, tho = u - dt * ud, th - dt * td
+    udo, tdo = ud - dt * acc_u, td - dt * acc_t
+    R, _ = residual_numpy(u, th, uo, tho, udo, tdo, 1 / dt, 0.3, sim.he, sim.hb, sim.prm,
+                          sim.iprm)
+    scale = sim.params.B * sim.scales[3]
+    assert np.abs(R).max() < 1e-9 * scale
+
+
+def test_bench_command_prints_json_last(tmp_path):
+    # a coarse grid and a soft regularisation keep the peer to seconds
+    proc = _cli("bench", "runs/paper_slip.toml", "--set", "numerics.elements=40",
+                "--set", "numerics.regularisation=0.05", "--no-cold")
+    assert proc.returncode == 0, proc.stderr
+    last = json.loads(proc.stdout.strip().splitlines()[-1])
+    for key in ("ours_wall_time", "ours_error", "peer_wall_time", "peer_error", "speedup",
+                "explicit_node_steps_per_s", "cold_start_time"):
+        assert key in last
+    assert last["ours_wall_time"] > 0 and last["peer_wall_time"] > 0
+    assert last["peer_converged"] is True
+    # same grid, same discretisation, same steady criterion: the same steady state
+    assert abs(last["ours_error"] - last["peer_error"]) < 1e-4
+    assert last["explicit_node_steps_per_s"] > 0
