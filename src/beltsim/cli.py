@@ -66,24 +66,48 @@ def format_summary(summary: dict, title: str = "") -> str:
 def cmd_run(args):
     from pathlib import Path
 
-    from .results import prepare_outdir, save_run
-    from .runner import run
+    from .results import prepare_outdir, save_run, write_atomic
+    from .runner import Simulation
 
-    scene = _scene(args)
-    out = prepare_outdir(args.out or Path("runs/out") / Path(args.scene).stem)
-    result = run(scene, progress=not args.quiet, raise_on_failure=False)
+    if args.resume:
+        if args.scene or args.overrides:
+            raise UsageError("--resume DIR continues a run as it was: give no SCENE or --set")
+        out = prepare_outdir(args.out or args.resume)
+        sim = Simulation.resume(Path(args.resume) / CHECKPOINT)
+        title = sim.scene.title or args.resume
+    else:
+        if not args.scene:
+            raise UsageError("run: give a SCENE file, or --resume DIR")
+        scene = _scene(args)
+        out = prepare_outdir(args.out or Path("runs/out") / Path(args.scene).stem)
+        sim = Simulation(scene)
+        title = scene.title or args.scene
+    # a summary.json present means the latest run in this directory finished
+    (out / "summary.json").unlink(missing_ok=True)
+    result = sim.run(progress=not args.quiet, raise_on_failure=False, handle_signals=True)
+    if result.interrupted:
+        sim.save_checkpoint(out / CHECKPOINT)
+        write_atomic(out / "scene.toml", sim.scene.to_toml())
+        print(f"beltsim: {result.reason}; checkpoint written, continue with "
+              f"'beltsim run --resume {out}'", file=sys.stderr)
+        return 130
     save_run(result, out)
     summary = result.summary()
-    print(format_summary(summary, title=scene.title or args.scene))
+    print(format_summary(summary, title=title))
     print(format_run(summary))
     print(f"wrote {out}/summary.json, fields.csv, history.csv")
     if result.failed:
+        sim.save_checkpoint(out / CHECKPOINT)  # the last good state
         print(f"beltsim: numerical failure: {result.reason}", file=sys.stderr)
         return 3
+    (out / CHECKPOINT).unlink(missing_ok=True)
     if not result.converged:
         print(f"beltsim: warning: {result.reason}", file=sys.stderr)
         return 1
     return 0
+
+
+CHECKPOINT = "checkpoint.npz"
 
 
 def format_run(summary: dict) -> str:
@@ -175,8 +199,12 @@ def build_parser():
     p.set_defaults(func=cmd_analytic)
 
     p = sub.add_parser("run", help="transient simulation from rest to steady state")
-    _add_scene_args(p)
+    p.add_argument("scene", nargs="?", help="scene file (TOML)")
+    p.add_argument("--set", dest="overrides", action="append", default=[],
+                   metavar="SECTION.KEY=VALUE", help="override a scene key (repeatable)")
     p.add_argument("--out", default=None, help="output directory (default runs/out/SCENE)")
+    p.add_argument("--resume", metavar="DIR", default=None,
+                   help="continue an interrupted run from DIR/checkpoint.npz")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_run)
 

@@ -17,7 +17,9 @@ Defaults (all overridable in [numerics]):
 * ``damping`` (inertia) 2 omega_1 with omega_1 = pi (b1 - rho c^2) / (L sqrt(rho b1)),
   the lowest axial frequency of the free span: it acts on u_t and theta_t only;
 * ``steady_tol`` 1e-6: relative rates and relative change of the total friction
-  per window (one transit time L / c) that count as steady.
+  per window (one transit time L / c) that count as steady;
+* ``newton_tol`` 1e-9 (scaled max norm of the Newton update) and
+  ``newton_max_iterations`` 30 per implicit step.
 """
 
 from __future__ import annotations
@@ -90,6 +92,8 @@ def resolve(scene: Scene) -> Numerics:
         dt=dt, t_end=t_end, ramp_time=ramp_time, law=law, vreg=vreg, fs=fs,
         damping=damping, steady_tol=nm.get("steady_tol", 1e-6),
         snapshot_interval=nm.get("snapshot_interval"),
+        newton_tol=nm.get("newton_tol", 1e-9),
+        newton_max_it=nm.get("newton_max_iterations", 30),
     )
 
 

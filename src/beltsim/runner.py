@@ -9,6 +9,7 @@ the progress bar.
 from __future__ import annotations
 
 import time
+import tomllib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -42,6 +43,7 @@ class RunResult:
     snapshots: dict = field(default_factory=dict)
     newton_iterations: int = 0
     compile_time: float = 0.0
+    interrupted: bool = False
 
     def errors(self) -> dict | None:
         if self.reference is None:
@@ -82,6 +84,7 @@ class Simulation:
         self.t = 0.0
         self.steps = 0
         self.dt = self.numerics.dt
+        self.wall_time = 0.0
         self.work = Workspace(N)
 
     # ------------------------------------------------------------------
@@ -147,71 +150,170 @@ class Simulation:
                 t=self.t, quantity=q)
 
     # ------------------------------------------------------------------
+    STATE = ("u", "theta", "lam", "ud", "td")
+
+    def _trackers(self, snapshot_interval):
+        """History, steady detector and snapshots: attributes, so a resumed run keeps them."""
+        if hasattr(self, "detector"):
+            return
+        num, P = self.numerics, self.params
+        window = P.L / P.c
+        self.check = window / 4.0
+        self.snap_dt = snapshot_interval or num.snapshot_interval
+        if self.snap_dt:
+            self.check = min(self.check, self.snap_dt)
+        self.detector = SteadyDetector(num.steady_tol, window, t_min=num.ramp_time)
+        self.history = {"t": [], "total_friction": [], "rate": []}
+        self.snaps = _Snapshots(self) if self.snap_dt else None
+        if self.snaps is not None:
+            self.snaps.take()
+        self.wall_time = 0.0
+
+    def _copy_state(self):
+        return [getattr(self, k).copy() for k in self.STATE] + [self.work.fnode.copy(), self.t,
+                                                                 self.steps, self.dt]
+
+    def _restore_state(self, saved):
+        for k, arr in zip(self.STATE, saved):
+            getattr(self, k)[:] = arr
+        self.work.fnode[:] = saved[len(self.STATE)]
+        self.t, self.steps, self.dt = saved[len(self.STATE) + 1:]
+
     def run(self, progress: bool = False, raise_on_failure: bool = True,
-            snapshot_interval: float | None = None) -> RunResult:
-        """Run from the current state until steady (or t_end); compare with the analytic state."""
+            snapshot_interval: float | None = None, handle_signals: bool = False,
+            callback=None) -> RunResult:
+        """Run from the current state until steady (or t_end); compare with the analytic state.
+
+        Between chunks of simulated time the trackers record the history, take snapshots
+        and test for steady state. On a numerical failure the state goes back to the last
+        good check (never a NaN state). With ``handle_signals`` (the CLI), SIGINT and
+        SIGTERM stop the run cleanly between chunks: ``result.interrupted`` is set and
+        :meth:`save_checkpoint` can store the state for :meth:`resume`. ``callback(sim)``
+        is called after every chunk (a user tracker); a true return value stops the run
+        the same way.
+        """
         num, P = self.numerics, self.params
         if num.integrator == "steady":
             return self._run_steady(raise_on_failure)
-        transit = P.L / P.c
-        window = transit
-        check = window / 4.0
-        snap_dt = snapshot_interval or num.snapshot_interval
-        if snap_dt:
-            check = min(check, snap_dt)
-        detector = SteadyDetector(num.steady_tol, window, t_min=num.ramp_time)
+        self._trackers(snapshot_interval)
+        hist, detector, snaps = self.history, self.detector, self.snaps
         fscale = P.B * self.scales[3] * 1e-3
-        hist_t, hist_f, hist_r = [], [], []
-        snaps = _Snapshots(self) if snap_dt else None
-        if snaps is not None:
-            snaps.take()
         compile_time = self.warm_up()
-        bar = _progress(progress, num.t_end)
-        converged, reason, failed = False, None, False
+        bar = _progress(progress, num.t_end, self.t)
+        converged, reason, failed, interrupted = False, None, False, False
         start = time.perf_counter()
-        try:
-            while self.t < num.t_end:
-                self.advance(min(self.t + check, num.t_end))
-                total = float(self.work.fnode.sum())
-                rate = self.rate()
-                hist_t.append(self.t)
-                hist_f.append(total)
-                hist_r.append(rate)
-                if snaps is not None and self.t >= snaps.next_time(snap_dt):
-                    snaps.take()
+        with _StopRequests(handle_signals) as stop:
+            try:
+                while self.t < num.t_end:
+                    if stop.requested:
+                        interrupted = True
+                        reason = f"interrupted ({stop.requested}) at t = {self.t:.6g} s"
+                        break
+                    good = self._copy_state()
+                    try:
+                        self.advance(min(self.t + self.check, num.t_end))
+                    except NumericalError:
+                        self._restore_state(good)
+                        raise
+                    total = float(self.work.fnode.sum())
+                    rate = self.rate()
+                    hist["t"].append(self.t)
+                    hist["total_friction"].append(total)
+                    hist["rate"].append(rate)
+                    if snaps is not None and self.t >= snaps.next_time(self.snap_dt):
+                        snaps.take()
+                    if bar is not None:
+                        bar.update(min(self.t, num.t_end) - bar.n)
+                        bar.set_postfix(rate=f"{rate:.2e}", friction=f"{total:.5g}",
+                                        refresh=False)
+                    if detector.update(self.t, rate, total, fscale):
+                        converged = True
+                        break
+                    if callback is not None and callback(self):
+                        stop.requested = "callback"
+            except NumericalError as exc:
+                reason, failed = str(exc), True
+                if raise_on_failure:
+                    raise
+            finally:
                 if bar is not None:
-                    bar.update(min(self.t, num.t_end) - bar.n)
-                    bar.set_postfix(rate=f"{rate:.2e}", friction=f"{total:.5g}", refresh=False)
-                if detector.update(self.t, rate, total, fscale):
-                    converged = True
-                    break
-        except NumericalError as exc:
-            reason, failed = str(exc), True
-            if raise_on_failure:
-                raise
-        finally:
-            if bar is not None:
-                bar.close()
-        wall = time.perf_counter() - start
-        if snaps is not None and (not snaps.times or snaps.times[-1] < self.t):
+                    bar.close()
+        self.wall_time += time.perf_counter() - start
+        if snaps is not None and not interrupted and snaps.times[-1] < self.t:
             snaps.take()
         if reason is None and not converged:
-            reason = (f"not steady by t_end = {num.t_end:.6g} s (rate {hist_r[-1]:.3g}, "
+            reason = (f"not steady by t_end = {num.t_end:.6g} s (rate {hist['rate'][-1]:.3g}, "
                       f"friction change {detector.change:.3g} per window; tolerance "
                       f"{num.steady_tol:.3g})")
+        return self._result(converged, reason, failed, compile_time,
+                            {k: np.array(v) for k, v in hist.items()},
+                            snaps.arrays() if snaps is not None else {}, interrupted)
+
+    def _result(self, converged, reason, failed, compile_time, history, snapshots,
+                interrupted=False):
         try:
             ref = analytic.solve(self.scene)
         except analytic.NoSolutionError:
             ref = None
         return RunResult(
-            scene=self.scene, numerics=num, solution=self.state(), reference=ref,
-            converged=converged, simulated_time=self.t, steps=self.steps, wall_time=wall,
-            history={"t": np.array(hist_t), "total_friction": np.array(hist_f),
-                     "rate": np.array(hist_r)},
-            reason=reason, failed=failed,
-            snapshots=snaps.arrays() if snaps is not None else {},
-            newton_iterations=int(self.work.stats[0]), compile_time=compile_time)
+            scene=self.scene, numerics=self.numerics, solution=self.state(), reference=ref,
+            converged=converged, simulated_time=self.t, steps=self.steps,
+            wall_time=self.wall_time, history=history, reason=reason, failed=failed,
+            snapshots=snapshots, newton_iterations=int(self.work.stats[0]),
+            compile_time=compile_time, interrupted=interrupted)
 
+    # checkpoints ------------------------------------------------------
+    def save_checkpoint(self, path):
+        """Store everything a resumed run needs to continue exactly as this one would."""
+        import io
+
+        from .results import write_atomic
+        det = self.detector
+        data = {k: getattr(self, k) for k in self.STATE}
+        data.update(
+            fnode=self.work.fnode, stats=self.work.stats,
+            scalars=np.array([self.t, self.steps, self.dt, self.wall_time, det._count,
+                              det.change, self.check, self.snap_dt or 0.0]),
+            detector=np.array(list(det._hist)).reshape(-1, 2),
+            hist=np.array([self.history[k] for k in ("t", "total_friction", "rate")]),
+            scene=np.array(self.scene.to_toml()),
+        )
+        if self.snaps is not None:
+            for k, v in self.snaps.arrays().items():
+                data[f"snap_{k}"] = v
+        buf = io.BytesIO()
+        np.savez(buf, **data)
+        return write_atomic(path, buf.getvalue())
+
+    @classmethod
+    def resume(cls, path) -> "Simulation":
+        """A simulation restored from :meth:`save_checkpoint`."""
+        from collections import deque
+
+        from .errors import SceneError
+        try:
+            z = np.load(path)
+            scene = Scene(tomllib.loads(str(z["scene"])))
+        except (OSError, ValueError, KeyError, tomllib.TOMLDecodeError) as exc:
+            raise SceneError(f"--resume: cannot read checkpoint {path} ({exc})") from None
+        sim = cls(scene)
+        for k in cls.STATE:
+            getattr(sim, k)[:] = z[k]
+        sim.work.fnode[:] = z["fnode"]
+        sim.work.stats[:] = z["stats"]
+        t, steps, dt, wall, count, change, check, snap_dt = z["scalars"]
+        sim._trackers(snap_dt or None)
+        sim.t, sim.steps, sim.dt, sim.wall_time = float(t), int(steps), float(dt), float(wall)
+        sim.check = float(check)
+        sim.detector._count, sim.detector.change = int(count), float(change)
+        sim.detector._hist = deque(map(tuple, z["detector"]))
+        for k, row in zip(("t", "total_friction", "rate"), z["hist"]):
+            sim.history[k] = list(row)
+        if sim.snaps is not None:
+            sim.snaps.times = list(z["snap_t"])
+            for k in ("u", "theta", "fnode"):
+                setattr(sim.snaps, k, list(z[f"snap_{k}"]))
+        return sim
 
     def solve_steady(self):
         """Newton on the discrete steady equations, with continuation in v - c.
@@ -262,17 +364,10 @@ class Simulation:
             reason, failed = str(exc), True
             if raise_on_failure:
                 raise
-        wall = time.perf_counter() - start
-        try:
-            ref = analytic.solve(self.scene)
-        except analytic.NoSolutionError:
-            ref = None
-        return RunResult(
-            scene=self.scene, numerics=self.numerics, solution=self.state(), reference=ref,
-            converged=not failed, simulated_time=0.0, steps=stages, wall_time=wall,
-            history={"t": np.zeros(0), "total_friction": np.zeros(0), "rate": np.zeros(0)},
-            reason=reason, failed=failed, newton_iterations=int(self.work.stats[0]),
-            compile_time=compile_time)
+        self.wall_time = time.perf_counter() - start
+        self.t, self.steps = 0.0, stages
+        empty = {"t": np.zeros(0), "total_friction": np.zeros(0), "rate": np.zeros(0)}
+        return self._result(not failed, reason, failed, compile_time, empty, {})
 
 
 def _stage_time(s):
@@ -311,7 +406,7 @@ class _Snapshots:
                 "theta": np.array(self.theta), "fnode": np.array(self.fnode)}
 
 
-def _progress(enabled, total):
+def _progress(enabled, total, initial=0.0):
     if not enabled:
         return None
     import sys
@@ -319,8 +414,40 @@ def _progress(enabled, total):
     from tqdm import tqdm
     if not sys.stderr.isatty():
         return None
-    return tqdm(total=total, unit="s", unit_scale=True, desc="simulated", leave=False,
+    return tqdm(total=total, initial=initial, unit="s", unit_scale=True, desc="simulated",
+                leave=False,
                 bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s [{elapsed}<{remaining}]{postfix}")
+
+
+class _StopRequests:
+    """SIGINT and SIGTERM set a flag that the run loop reads between chunks.
+
+    A KeyboardInterrupt raised while a kernel returns could leave the time and the
+    state out of step; a flag checked at a chunk boundary cannot.
+    """
+
+    def __init__(self, enabled):
+        import threading
+        self.enabled = enabled and threading.current_thread() is threading.main_thread()
+        self.requested = None
+        self._old = {}
+
+    def __enter__(self):
+        if self.enabled:
+            import signal
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self._old[sig] = signal.signal(sig, self._handler)
+        return self
+
+    def _handler(self, signum, frame):
+        import signal
+        self.requested = signal.Signals(signum).name
+
+    def __exit__(self, *exc):
+        import signal
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+        return False
 
 
 def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,

@@ -123,6 +123,8 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "damping": _Rule("float", nonneg=True),
         "steady_tol": POS,
         "snapshot_interval": POS,
+        "newton_tol": POS,
+        "newton_max_iterations": _Rule("int", minimum=1),
     },
 }
 

@@ -1,0 +1,110 @@
+"""Failure, interruption and resume: never a quiet wrong number."""
+
+import json
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import beltsim
+from beltsim.results import read_csv
+from beltsim.runner import Simulation
+
+
+def _scene(*overrides, name="paper_slip"):
+    return beltsim.load_scene(f"runs/{name}.toml", ["numerics.elements=200", *overrides])
+
+
+@pytest.mark.parametrize("integrator", ["implicit", "explicit"])
+def test_resume_reaches_the_same_state_as_an_uninterrupted_run(tmp_path, integrator):
+    scene = _scene(f"numerics.integrator={integrator}", "numerics.snapshot_interval=0.005")
+    whole = Simulation(scene).run()
+    part = Simulation(scene)
+    chunks = []
+    first = part.run(callback=lambda sim: chunks.append(sim.t) or len(chunks) >= 9)
+    assert first.interrupted and not first.converged
+    part.save_checkpoint(tmp_path / "ck.npz")
+    rest = Simulation.resume(tmp_path / "ck.npz").run()
+    assert rest.converged and whole.converged
+    assert rest.steps == whole.steps and rest.simulated_time == whole.simulated_time
+    # the same arithmetic in the same order: bit for bit
+    np.testing.assert_array_equal(rest.solution.u, whole.solution.u)
+    np.testing.assert_array_equal(rest.solution.theta, whole.solution.theta)
+    np.testing.assert_array_equal(rest.history["total_friction"],
+                                  whole.history["total_friction"])
+    np.testing.assert_array_equal(rest.snapshots["t"], whole.snapshots["t"])
+
+
+def test_sigterm_writes_a_checkpoint_and_resume_finishes(tmp_path):
+    """The CLI path with a real signal: exit 130, a checkpoint, no summary; the resumed
+    run ends where an uninterrupted one does."""
+    args = ["runs/paper_slip.toml", "--set", "numerics.integrator=explicit", "--set",
+            "numerics.elements=1500", "--quiet"]
+    ref = subprocess.run([sys.executable, "-m", "beltsim.cli", "run", *args, "--out",
+                          str(tmp_path / "ref")], capture_output=True, text=True, timeout=600)
+    assert ref.returncode == 0, ref.stderr
+    for wait in (2.0, 4.0, 8.0):  # the signal must land after start-up, before the end
+        out = tmp_path / f"cut{wait}"
+        proc = subprocess.Popen([sys.executable, "-m", "beltsim.cli", "run", *args, "--out",
+                                 str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True)
+        time.sleep(wait)
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=600)
+        if proc.returncode == 130:
+            break
+    else:
+        pytest.fail(f"never interrupted mid-run: last exit {proc.returncode}, {err}")
+    assert (out / "checkpoint.npz").exists() and not (out / "summary.json").exists()
+    assert "resume" in err and err.count("\n") == 1
+    done = subprocess.run([sys.executable, "-m", "beltsim.cli", "run", "--resume", str(out),
+                           "--quiet"], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    a, b = read_csv(out / "fields.csv"), read_csv(tmp_path / "ref" / "fields.csv")
+    np.testing.assert_array_equal(a["u"], b["u"])
+    assert not (out / "checkpoint.npz").exists()
+
+
+def test_divergence_stops_with_reason_and_last_good_state(tmp_path):
+    """A step far above the explicit limit (forced past the refusal) diverges: the run
+    stops with the time and quantity, keeps a finite state, and the CLI exits 3."""
+    sim = Simulation(_scene("numerics.integrator=explicit"))
+    sim.numerics = sim.numerics.__class__(**{**sim.numerics.__dict__,
+                                             "dt": 3 * sim.numerics.dt})
+    res = sim.run(raise_on_failure=False)
+    assert res.failed and not res.converged
+    assert "at t = " in res.reason and ("grew without bound" in res.reason
+                                        or "non-finite" in res.reason)
+    assert np.all(np.isfinite(res.solution.u)) and np.all(np.isfinite(res.solution.theta))
+    summary = res.summary()
+    assert summary["converged"] is False and summary["reason"] == res.reason
+    with pytest.raises(beltsim.NumericalError):
+        sim2 = Simulation(_scene("numerics.integrator=explicit"))
+        sim2.numerics = sim.numerics
+        sim2.run()
+
+
+def test_newton_failure_is_reported_with_time():
+    """One Newton iteration cannot solve a step of the nonlinear problem: the step is
+    cut back until it is too small, and the run stops naming the time."""
+    res = Simulation(_scene("numerics.newton_max_iterations=1")).run(raise_on_failure=False)
+    assert res.failed and "Newton iteration failed at t = " in res.reason
+    assert np.all(np.isfinite(res.solution.u))
+
+
+def test_cli_numerical_failure_exits_3_with_summary_and_last_good_state(tmp_path):
+    proc = subprocess.run(
+        [sys.executable, "-m", "beltsim.cli", "run", "runs/paper_slip.toml", "--quiet",
+         "--out", str(tmp_path), "--set", "numerics.elements=200", "--set",
+         "numerics.newton_max_iterations=1"], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 3, proc.stderr
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    assert "numerical failure" in proc.stderr and "at t = " in proc.stderr
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["converged"] is False and "Newton" in summary["reason"]
+    fields = read_csv(tmp_path / "fields.csv")
+    assert all(np.all(np.isfinite(v)) for v in fields.values())
+    assert (tmp_path / "checkpoint.npz").exists()  # the last good state
