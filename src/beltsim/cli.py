@@ -84,7 +84,10 @@ def cmd_run(args):
         title = scene.title or args.scene
     # a summary.json present means the latest run in this directory finished
     (out / "summary.json").unlink(missing_ok=True)
-    result = sim.run(progress=not args.quiet, raise_on_failure=False, handle_signals=True)
+    if args.snapshots is not None and not args.snapshots > 0:
+        raise UsageError(f"--snapshots: must be > 0 s, got {args.snapshots}")
+    result = sim.run(progress=not args.quiet, raise_on_failure=False, handle_signals=True,
+                     snapshot_interval=args.snapshots)
     if result.interrupted:
         sim.save_checkpoint(out / CHECKPOINT)
         write_atomic(out / "scene.toml", sim.scene.to_toml())
@@ -205,6 +208,9 @@ def build_parser():
     p.add_argument("--out", default=None, help="output directory (default runs/out/SCENE)")
     p.add_argument("--resume", metavar="DIR", default=None,
                    help="continue an interrupted run from DIR/checkpoint.npz")
+    p.add_argument("--snapshots", metavar="INTERVAL", type=float, default=None,
+                   help="store the state every INTERVAL seconds of simulated time in "
+                        "DIR/snapshots.npz (for 'beltsim animate --from DIR')")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_run)
 

@@ -37,6 +37,15 @@ def prepare_outdir(path) -> Path:
     return path
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+_UMASK = _umask()
+
+
 def write_atomic(path, data: bytes | str) -> Path:
     """Write ``data`` to ``path`` through a temporary file and a rename."""
     path = Path(path)
@@ -51,6 +60,7 @@ def write_atomic(path, data: bytes | str) -> Path:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes it private; outputs are ordinary files
         os.replace(tmp, path)
     except BaseException:
         try:
@@ -122,6 +132,48 @@ def save_run(result, out) -> list[Path]:
                    result.history["rate"]]),
         write_atomic(out / "scene.toml", result.scene.to_toml()),
     ]
+    if result.snapshots:
+        paths.append(write_snapshots(out / SNAPSHOTS, result))
     # the summary last: its presence means the other files are complete
     paths.append(write_json(out / "summary.json", result.summary()))
     return paths
+
+
+SNAPSHOTS = "snapshots.npz"
+
+
+def write_snapshots(path, result) -> Path:
+    """States at every snapshot interval, compressed, in single precision.
+
+    Arrays: ``x`` (nodes), ``t`` (times), ``u``, ``theta``, ``friction`` (element
+    traction in N/m at the downstream node, as in fields.csv), each (times, nodes);
+    ``scene`` (the scene as TOML text). Single precision keeps a long run's file small
+    and is far finer than a plot.
+    """
+    import io
+
+    sol = result.solution
+    snaps = result.snapshots
+    he = sol.grid.he
+    traction = np.zeros_like(snaps["fnode"])
+    traction[:, 1:] = snaps["fnode"][:, 1:] / he
+    buf = io.BytesIO()
+    np.savez_compressed(buf, x=sol.x, t=snaps["t"], u=snaps["u"].astype(np.float32),
+                        theta=snaps["theta"].astype(np.float32),
+                        friction=traction.astype(np.float32),
+                        scene=np.array(result.scene.to_toml()))
+    return write_atomic(path, buf.getvalue())
+
+
+def read_snapshots(path) -> dict:
+    """The arrays of :func:`write_snapshots`, with ``scene`` as a Scene."""
+    import tomllib
+
+    from .scene import Scene
+    try:
+        with np.load(path) as z:
+            data = {k: z[k] for k in ("x", "t", "u", "theta", "friction")}
+            data["scene"] = Scene(tomllib.loads(str(z["scene"])))
+    except (OSError, KeyError, ValueError) as exc:
+        raise OutputError(f"{path}: not a beltsim snapshots file ({exc})") from None
+    return data
