@@ -166,6 +166,33 @@ def cmd_bench(args):
     return 0
 
 
+def cmd_stability(args):
+    from pathlib import Path
+
+    from . import studies
+    from .results import prepare_outdir, write_atomic, write_csv
+
+    out = prepare_outdir(args.out or Path("runs/out/stability"))
+    extra = [f"numerics.elements={args.elements}"] if args.elements else []
+    cases = studies.STABILITY_CASES
+    if args.elements:  # a coarse matrix: the fine-grid case is the default one coarsened
+        cases = tuple(c for c in cases if "numerics.elements=20000" not in c[2])
+    cols = ("case", "scheme", "status", "dt", "steps", "wall_time") + tuple(
+        f"error_{k}" for k in studies.ERROR_KEYS) + ("reason",)
+
+    def show(row):
+        print(f"{row['case']:<40s} {row['scheme']:<9s} {row['status']:<15s} "
+              f"wall {row['wall_time']:.3g} s  {row['reason'][:90]}", flush=True)
+    rows = studies.stability_matrix(cases, extra=extra, progress=show)
+    write_csv(out / "stability.csv", cols, [[r[c] for r in rows] for c in cols],
+              text_columns={"case", "scheme", "status", "reason"})
+    write_atomic(out / "stability.md", studies.stability_markdown(rows))
+    bad = [r for r in rows if r["status"] not in ("converged", "refused", "not applicable")]
+    print(f"wrote {out / 'stability.csv'} and {out / 'stability.md'}; "
+          f"{len(rows) - len(bad)} of {len(rows)} cells converged, refused or not applicable")
+    return 1 if bad else 0
+
+
 def _int_list(text, name):
     try:
         vals = [int(v) for v in text.split(",")]
@@ -223,6 +250,13 @@ def build_parser():
     p.add_argument("--schemes", default=None,
                    help="comma-separated subset of explicit,implicit,steady")
     p.set_defaults(func=cmd_convergence)
+
+    p = sub.add_parser("stability", help="stiff and extreme scenes by integrator: converged, "
+                       "refused or not applicable, never NaN")
+    p.add_argument("--out", default=None, help="output directory")
+    p.add_argument("--elements", type=int, default=None,
+                   help="run every case on this many elements (a quick, coarse matrix)")
+    p.set_defaults(func=cmd_stability)
 
     p = sub.add_parser("bench", help="paper slip scene: ours against a solve_ivp peer, "
                        "explicit kernel speed, cold start")

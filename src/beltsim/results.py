@@ -94,15 +94,19 @@ def write_json(path, obj) -> Path:
 def write_csv(path, header, columns, text_columns=()) -> Path:
     """Columns of equal length under a header, full double precision.
 
-    Columns named in ``text_columns`` are written as they are; numbers as repr()
-    (round-trips exactly), NaN as "nan".
+    Columns named in ``text_columns`` are written as text (quoted where needed);
+    numbers as repr() (round-trips exactly), NaN as "nan".
     """
-    cols = [list(c) if name in text_columns else [float(v) for v in np.asarray(c, dtype=float)]
+    import csv
+    import io
+
+    cols = [list(c) if name in text_columns else [repr(float(v)) for v in np.asarray(c, float)]
             for name, c in zip(header, columns)]
-    lines = [",".join(header)]
-    for row in zip(*cols):
-        lines.append(",".join(v if isinstance(v, str) else repr(v) for v in row))
-    return write_atomic(path, "\n".join(lines) + "\n")
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows(zip(*cols))
+    return write_atomic(path, buf.getvalue())
 
 
 def write_fields(path, x, fields: dict) -> Path:

@@ -460,3 +460,24 @@ def load_scene(path, overrides=()) -> Scene:
     """Load a scene file and apply ``SECTION.KEY=VALUE`` overrides."""
     scene = Scene.load(path)
     return scene.with_overrides(overrides) if overrides else scene
+
+
+def runs_dir() -> Path:
+    """The repository's runs/ folder (scene files), from the working directory or the package.
+
+    The paper's scenes ship in runs/ of a source checkout (the package is installed
+    from it in editable mode).
+    """
+    candidates = [Path.cwd() / "runs"]
+    here = Path(__file__).resolve()
+    candidates += [p / "runs" for p in here.parents]
+    for c in candidates:
+        if (c / "paper_slip.toml").is_file():
+            return c
+    raise SceneError("runs/: the paper's scene files were not found (run from a beltsim "
+                     "source checkout)")
+
+
+def paper_scene(name: str, overrides=()) -> Scene:
+    """One of the paper's scenes: "quasistatic", "inertia" or "slip"."""
+    return load_scene(runs_dir() / f"paper_{name}.toml", overrides)

@@ -225,3 +225,95 @@ def bench(scene_path, overrides=(), peer=True, cold=True, log=print) -> dict:
 def bench_json(result: dict) -> str:
     return json.dumps({k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                        for k, v in result.items()})
+
+
+# ---------------------------------------------------------------------------
+# Stability matrix
+
+#: The acceptance bounds of the transient simulator (relative errors; slip start in m).
+BOUNDS = {"total_friction": 5e-3, "u": 2e-2, "theta": 2e-2, "concentrated_force": 5e-2,
+          "slip_start": 5e-3}
+
+_THIN = ("beam.height=0.01",)
+#: (name, base scene, overrides): each derived from the paper's data.
+STABILITY_CASES = (
+    ("paper quasistatic", "paper_quasistatic", ()),
+    ("paper inertia", "paper_inertia", ()),
+    ("paper slip", "paper_slip", ()),
+    ("stiff friction (v_reg 1e-5, f* 1e8)", "paper_slip",
+     ("contact.max_friction=1e8", "numerics.regularisation=1e-5")),
+    ("stiff belt (E x 100)", "paper_slip", ("beam.youngs_modulus=5e9",)),
+    ("thin belt (h = 0.01 m)", "paper_slip", _THIN),
+    ("thin belt, quasistatic", "paper_slip", _THIN + ("physics.inertia=false",)),
+    ("near-critical (c = 0.97 sqrt(a/I))", "paper_slip",
+     ("motion.belt_speed=125.2265", "motion.surface_speed=126.4787")),
+    ("large mismatch (v/c - 1 = 0.05)", "paper_slip", ("motion.surface_speed=126",)),
+    ("v = c (zero state)", "paper_slip", ("motion.surface_speed=120",)),
+    ("v < c (reversed forces)", "paper_slip", ("motion.surface_speed=118.8",)),
+    ("short contact (x2 - x1 = 0.02 L)", "paper_slip", ("contact.start=0.49",
+                                                          "contact.end=0.51")),
+    ("contact ends 0.02 L from the outlet", "paper_slip", ("contact.start=0.6466666666666666",
+                                                            "contact.end=0.98")),
+    ("very fine grid (20,000 elements)", "paper_slip", ("numerics.elements=20000",)),
+)
+
+
+def stability_cell(base, overrides, scheme, extra=()):
+    """One cell: status, reason, dt, steps, wall time and errors of one scheme on one case."""
+    from .errors import BeltsimError
+    from .scene import load_scene, runs_dir
+
+    cell = {"scheme": scheme, "status": "", "reason": "", "dt": float("nan"), "steps": 0,
+            "wall_time": float("nan"), **{f"error_{k}": float("nan") for k in ERROR_KEYS}}
+    try:
+        scene = load_scene(runs_dir() / f"{base}.toml",
+                           [*overrides, *extra, f"numerics.integrator={scheme}"])
+        sim = Simulation(scene)
+    except BeltsimError as exc:
+        msg = str(exc)
+        not_applicable = "needs physics.inertia = true" in msg
+        cell.update(status="not applicable" if not_applicable else "refused", reason=msg)
+        return cell
+    res = sim.run(raise_on_failure=False)
+    err = res.errors() or {}
+    cell.update(dt=sim.numerics.dt if scheme != "steady" else float("nan"), steps=res.steps,
+                wall_time=res.wall_time,
+                **{f"error_{k}": err[k] for k in ERROR_KEYS if err.get(k) is not None})
+    if res.failed:
+        cell.update(status="diverged", reason=res.reason)
+    elif not res.converged:
+        cell.update(status="not converged", reason=res.reason)
+    else:
+        over = [f"{k} {err[k]:.3g} > {b:g}" for k, b in BOUNDS.items()
+                if err.get(k) is not None and not err[k] <= b]
+        cell.update(status="out of bounds" if over else "converged", reason="; ".join(over))
+    return cell
+
+
+def stability_matrix(cases=STABILITY_CASES, schemes=("explicit", "implicit", "steady"),
+                     extra=(), progress=None) -> list[dict]:
+    rows = []
+    for name, base, overrides in cases:
+        for scheme in schemes:
+            row = {"case": name, **stability_cell(base, overrides, scheme, extra=extra)}
+            rows.append(row)
+            if progress:
+                progress(row)
+    return rows
+
+
+def stability_markdown(rows) -> str:
+    """A table per case and scheme: status, dt, steps, wall time, errors, reason."""
+    head = ("| case | scheme | status | dt [s] | steps | wall [s] | total friction | u | theta "
+            "| conc. force | slip start [m] | reason |")
+    lines = [head, "|" + "---|" * 12]
+
+    def num(v, fmt):
+        return "" if v is None or (isinstance(v, float) and not math.isfinite(v)) else fmt % v
+    for r in rows:
+        lines.append("| " + " | ".join([
+            r["case"], r["scheme"], r["status"], num(r["dt"], "%.2e"), str(r["steps"]),
+            num(r["wall_time"], "%.3g"),
+            *(num(r[f"error_{k}"], "%.1e") for k in ERROR_KEYS),
+            r["reason"].replace("|", "/")]) + " |")
+    return "\n".join(lines) + "\n"
