@@ -193,6 +193,46 @@ def cmd_stability(args):
     return 1 if bad else 0
 
 
+def cmd_sweep(args):
+    from pathlib import Path
+
+    import numpy as np
+
+    from . import analytic, plots, sweep
+    from .results import prepare_outdir, write_csv
+
+    scene = _scene(args)
+    key, values = sweep.parse_vary(args.vary)
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers: must be >= 1, got {args.workers}")
+    out = prepare_outdir(args.out or Path("runs/out") / f"sweep_{Path(args.scene).stem}")
+    collapse = key == "contact.max_friction"
+    executor = sweep.make_executor(args.workers, args.scheduler)
+
+    def show(row):
+        print(f"  {key} = {row['value']!r:<12} total friction {row['total_friction']:.6g} N "
+              f"(analytic {row['total_friction_analytic']:.6g}), wall {row['wall_time']:.3g} s"
+              f"{'' if row['converged'] else ', NOT converged: ' + str(row['reason'])}",
+              flush=True)
+    rows = sweep.sweep(scene, key, values, executor, keep_theta=collapse, progress=show)
+    cols = [key] + list(sweep.KEYS) + [f"{k}_analytic" for k in sweep.KEYS] + [
+        "converged", "wall_time"]
+    data = [[r["value"] for r in rows]] + [[r[c] for r in rows] for c in cols[1:]]
+    data = [[np.nan if v is None else v for v in col] for col in data]
+    write_csv(out / "sweep.csv", cols, data)
+    print(f"wrote {out / 'sweep.csv'}")
+    if collapse:
+        P = scene.params
+        for r in rows:
+            sc = scene.with_overrides([(key, r["value"])])
+            xs, f = analytic.solve(sc).sample(801)
+            r.update(x2=P.x2, x_exact=xs, theta_exact=f["theta"],
+                     theta_adhesion=analytic.solve(sc, model="stick").fields(xs)["theta"])
+        plots.creep_collapse(rows, out / "creep_collapse.png", title=scene.title)
+        print(f"wrote {out / 'creep_collapse.png'}")
+    return 0 if all(r["converged"] for r in rows) else 1
+
+
 def _int_list(text, name):
     try:
         vals = [int(v) for v in text.split(",")]
@@ -250,6 +290,18 @@ def build_parser():
     p.add_argument("--schemes", default=None,
                    help="comma-separated subset of explicit,implicit,steady")
     p.set_defaults(func=cmd_convergence)
+
+    p = sub.add_parser("sweep", help="run a scene for several values of one key, in "
+                       "parallel")
+    _add_scene_args(p)
+    p.add_argument("--vary", required=True, metavar="SECTION.KEY=V1,V2,...",
+                   help="the key and its values")
+    p.add_argument("--out", default=None, help="output directory")
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes (default: one per core)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on a Dask distributed cluster (pip install 'beltsim[dask]')")
+    p.set_defaults(func=cmd_sweep)
 
     p = sub.add_parser("stability", help="stiff and extreme scenes by integrator: converged, "
                        "refused or not applicable, never NaN")

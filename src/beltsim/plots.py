@@ -36,3 +36,59 @@ def error_vs_runtime(rows, path, title=""):
     fig.savefig(path, dpi=130)
     plt.close(fig)
     return path
+
+
+def creep_collapse(rows, path, title=""):
+    """Three panels for a sweep over f*: slip-zone length, theta(x), total friction."""
+    plt = _pyplot()
+    fs = np.array([r["value"] for r in rows], dtype=float)
+    x2 = rows[0]["x2"]
+    sim_len = np.array([x2 - r["slip_start"] for r in rows])
+    ex_len = np.array([x2 - r["slip_start_analytic"] for r in rows])
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), constrained_layout=True)
+    ax = axes[0]
+    ax.loglog(fs, ex_len, "-", color="k", label="analytic")
+    pos = sim_len > 0
+    ax.loglog(fs[pos], sim_len[pos], "o", color="tab:red", label="simulation")
+    hmin = np.array([r["h_min"] for r in rows])
+    ax.loglog(fs, hmin, ":", color="0.5", label="smallest element")
+    ax.set_xlabel("f* [N/m]")
+    ax.set_ylabel("slip-zone length x2 - x* [m]")
+    ax.set_title("Creep zone collapses onto x2")
+    ax.legend()
+    ax.grid(True, which="both", alpha=0.3)
+
+    ax = axes[1]
+    picks = [rows[i] for i in sorted({0, len(rows) // 2, len(rows) - 1}) if "theta" in rows[i]]
+    colors = ["tab:blue", "tab:orange", "tab:green", "tab:purple"]
+    for r, col in zip(picks, colors):
+        ax.plot(r["x_exact"], r["theta_exact"], "-", color=col, lw=1.2)
+        step = max(1, len(r["x"]) // 60)
+        ax.plot(r["x"][::step], r["theta"][::step], "o", ms=3, color=col,
+                label=f"f* = {r['value']:.3g} N/m")
+    if picks:
+        ax.plot(picks[0]["x_exact"], picks[0]["theta_adhesion"], "--", color="k",
+                label="perfect adhesion")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("theta [rad]")
+    ax.set_title("Rotation: simulation (markers), analytic (lines)")
+    ax.legend(fontsize=8)
+    ax.grid(True, alpha=0.3)
+
+    ax = axes[2]
+    tot = np.array([r["total_friction"] for r in rows])
+    ax.semilogx(fs, tot, "o", color="tab:red", label="simulation")
+    ax.semilogx(fs, [r["total_friction_analytic"] for r in rows], "-", color="k",
+                label="analytic (stick and slip)")
+    ax.axhline(rows[0]["total_friction_adhesion"], ls="--", color="tab:blue",
+               label="perfect adhesion")
+    ax.set_xlabel("f* [N/m]")
+    ax.set_ylabel("total friction [N]")
+    ax.set_title("Total friction tends to the adhesion value")
+    ax.legend()
+    ax.grid(True, which="both", alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,86 @@
+"""Sweeps, and the paper's central claim: the creep zone collapses onto x2 as f* grows."""
+
+import csv
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+
+from beltsim import sweep
+from beltsim.errors import SceneError, UsageError
+from beltsim.scene import paper_scene
+
+F_STARS = (5e4, 7e4, 1e5, 2e5, 5e5, 1e6)
+
+
+@pytest.fixture(scope="module")
+def collapse():
+    scene = paper_scene("slip")
+    with ThreadPoolExecutor(max_workers=2) as ex:  # any Executor serves
+        return sweep.sweep(scene, "contact.max_friction", [*F_STARS, 1e7], ex)
+
+
+def test_simulated_slip_zone_matches_the_analytic_one(collapse):
+    """Within 5% or two grid cells (whichever is larger) from f* = 5e4 to 1e6."""
+    for r in collapse[:-1]:
+        x2 = paper_scene("slip").params.x2
+        sim, exact = x2 - r["slip_start"], x2 - r["slip_start_analytic"]
+        assert r["converged"]
+        assert abs(sim - exact) <= max(0.05 * exact, 2 * r["h_min"]), r["value"]
+
+
+def test_slip_zone_shrinks_monotonically(collapse):
+    lengths = [r["slip_start"] for r in collapse]
+    assert all(b >= a for a, b in zip(lengths, lengths[1:]))  # x* moves towards x2
+    assert lengths[-1] > lengths[0]
+
+
+def test_large_friction_limit_is_perfect_adhesion(collapse):
+    """At f* = 1e7 the total friction is within 0.3% of the perfect-adhesion value."""
+    last = collapse[-1]
+    assert last["value"] == 1e7
+    rel = abs(last["total_friction"] - last["total_friction_adhesion"])
+    assert rel / last["total_friction_adhesion"] < 3e-3
+
+
+def test_parse_vary_validates():
+    assert sweep.parse_vary("contact.max_friction=1e5, 2e5") == (
+        "contact.max_friction", [1e5, 2e5])
+    with pytest.raises(UsageError):
+        sweep.parse_vary("contact.max_friction")
+    with pytest.raises(SceneError):
+        sweep.parse_vary("contact.nonsense=1,2")
+    with pytest.raises(SceneError):  # a bad value fails before any run starts
+        sweep.sweep(paper_scene("slip"), "contact.max_friction", [1e5, -1.0])
+
+
+def test_sweep_command_writes_csv_and_figure(tmp_path):
+    proc = subprocess.run(
+        [sys.executable, "-m", "beltsim.cli", "sweep", "runs/paper_slip.toml", "--vary",
+         "contact.max_friction=5e4,1e5,1e6", "--set", "numerics.elements=300", "--workers",
+         "2", "--out", str(tmp_path)], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    rows = list(csv.DictReader((tmp_path / "sweep.csv").open()))
+    assert [float(r["contact.max_friction"]) for r in rows] == [5e4, 1e5, 1e6]
+    for r in rows:
+        assert r["converged"] == "1.0"
+        for k in ("total_friction", "stick_friction", "slip_friction", "slip_start"):
+            assert np.isfinite(float(r[k])) and np.isfinite(float(r[f"{k}_analytic"]))
+    assert (tmp_path / "creep_collapse.png").stat().st_size > 20_000
+
+
+def test_scheduler_without_dask_is_a_clean_error(tmp_path):
+    pytest.importorskip("numpy")
+    try:
+        import distributed  # noqa: F401
+        pytest.skip("dask is installed")
+    except ImportError:
+        pass
+    proc = subprocess.run(
+        [sys.executable, "-m", "beltsim.cli", "sweep", "runs/paper_slip.toml", "--vary",
+         "contact.max_friction=1e5", "--scheduler", "tcp://127.0.0.1:1", "--out",
+         str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "dask" in proc.stderr.lower()
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
