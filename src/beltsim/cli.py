@@ -233,6 +233,23 @@ def cmd_sweep(args):
     return 0 if all(r["converged"] for r in rows) else 1
 
 
+def cmd_paper(args):
+    from pathlib import Path
+
+    from . import paper
+
+    sims = None
+    if not args.no_sim:
+        def show(key, res):
+            print(f"  simulated {key}: {'steady' if res.converged else 'NOT steady'} after "
+                  f"{res.steps} steps, wall {res.wall_time:.3g} s", flush=True)
+        sims = paper.simulate(progress=show)
+    result = paper.reproduce(args.out or Path("runs/out/paper"), simulated=sims)
+    print(paper.format_table1(result["table"]))
+    print("wrote " + ", ".join(str(p) for p in result["paths"]))
+    return 0
+
+
 def _int_list(text, name):
     try:
         vals = [int(v) for v in text.split(",")]
@@ -290,6 +307,13 @@ def build_parser():
     p.add_argument("--schemes", default=None,
                    help="comma-separated subset of explicit,implicit,steady")
     p.set_defaults(func=cmd_convergence)
+
+    p = sub.add_parser("paper", help="the paper's Table 1 and Figures 2-7 (analytic, with "
+                       "simulated markers)")
+    p.add_argument("--out", default=None, help="output directory (default runs/out/paper)")
+    p.add_argument("--no-sim", action="store_true",
+                   help="analytic curves only, no simulated markers")
+    p.set_defaults(func=cmd_paper)
 
     p = sub.add_parser("sweep", help="run a scene for several values of one key, in "
                        "parallel")
