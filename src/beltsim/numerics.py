@@ -45,6 +45,8 @@ DEFAULT_GRADING = 8.0
 # free segments, 1/alpha in stick): 16 resolves the paper's 17 mm layer like 1000
 # elements do, and keeps the theta error below 2% where 1000 elements did not (h = 0.01 m)
 ELEMENTS_PER_LAYER = 16.0
+MIN_MISMATCH = 1e-8  # smallest nonzero |v/c - 1| a run accepts
+MIN_VREG = 1e-12  # smallest regularisation velocity, relative to c
 
 
 @dataclass(frozen=True)
@@ -78,10 +80,20 @@ def resolve(scene: Scene) -> Numerics:
     t_end = nm.get("t_end", ramp_time + 400.0 * transit)
     if dt > t_end:
         raise SceneError(f"numerics.dt: must be <= numerics.t_end = {t_end!r}, got {dt!r}")
+    if 0.0 < abs(P.e0) < MIN_MISMATCH:
+        raise SceneError(
+            f"motion.surface_speed: |v/c - 1| = {abs(P.e0):.3g} is below {MIN_MISMATCH:g} "
+            f"but not 0: in double precision v - c then carries a round-off of "
+            f"{2.2e-16 / abs(P.e0):.1%} and the friction law cannot resolve it; use v = c "
+            f"for the zero state")
     if P.friction == "coulomb":
         dv = abs(P.v - P.c)
         vreg = nm.get("regularisation", 1e-4 * dv if dv > 0 else 1e-6 * P.c)
         law, fs = nm.get("friction_law", "tanh"), P.fstar
+        if vreg < MIN_VREG * P.c:
+            raise SceneError(f"numerics.regularisation: must be >= {MIN_VREG:g} c = "
+                             f"{MIN_VREG * P.c:.3g} m/s (below it slip velocities drown in "
+                             f"round-off), got {vreg!r}")
     else:
         delta = nm.get("adhesion_layer", 1e-6 * P.L)
         law, vreg = "linear", 1.0

@@ -1,0 +1,185 @@
+"""Scene validation: every rule gives its own one-line error naming the key and the rule,
+a ValueError from the API and exit status 2 without a traceback from the CLI."""
+
+import copy
+import math
+import subprocess
+import sys
+import tomllib
+
+import pytest
+
+from beltsim.errors import SceneError
+from beltsim.scene import SCHEMA, Scene, load_scene
+
+with open("runs/paper_slip.toml", "rb") as fh:
+    BASE = tomllib.load(fh)  # coulomb, inertia
+
+
+def _with(path, value, base=BASE):
+    d = copy.deepcopy(base)
+    section, key = path.split(".")
+    if value is _DELETE:
+        del d[section][key]
+    else:
+        d.setdefault(section, {})[key] = value
+    return d
+
+
+_DELETE = object()
+
+
+def _error(data):
+    with pytest.raises(SceneError) as info:
+        Scene.from_dict(data)
+    msg = str(info.value)
+    assert "\n" not in msg
+    assert isinstance(info.value, ValueError)
+    return msg
+
+
+def test_paper_scenes_are_valid():
+    for name in ("quasistatic", "inertia", "slip"):
+        load_scene(f"runs/paper_{name}.toml")
+    assert BASE["contact"]["start"] == 1 / 3 and BASE["contact"]["end"] == 2 / 3
+
+
+def test_unknown_section_and_key():
+    assert _error({**BASE, "extra": {"a": 1}}).startswith("extra: unknown section")
+    assert _error(_with("beam.colour", 1.0)).startswith("beam.colour: unknown key")
+    assert _error({**BASE, "title": 3}).startswith("title: must be a string")
+
+
+@pytest.mark.parametrize("section", ["beam", "motion", "contact", "physics"])
+def test_missing_section(section):
+    d = copy.deepcopy(BASE)
+    del d[section]
+    assert _error(d) == f"[{section}]: missing section"
+
+
+@pytest.mark.parametrize("key", [f"beam.{k}" for k in SCHEMA["beam"]]
+                         + ["motion.belt_speed", "motion.surface_speed", "contact.start",
+                            "contact.end", "contact.friction", "contact.max_friction",
+                            "physics.inertia"])
+def test_missing_key(key):
+    assert _error(_with(key, _DELETE)).startswith(f"{key}: missing key")
+
+
+POSITIVE = ([f"beam.{k}" for k in ("length", "height", "width", "youngs_modulus", "density",
+                                    "shear_factor")]
+            + ["motion.belt_speed", "motion.surface_speed", "contact.max_friction"]
+            + [f"stiffness.{k}" for k in SCHEMA["stiffness"]])
+
+
+@pytest.mark.parametrize("key", POSITIVE)
+@pytest.mark.parametrize("value", [0.0, -1.0])
+def test_non_positive(key, value):
+    assert _error(_with(key, value)) == f"{key}: must be > 0, got {value!r}"
+
+
+@pytest.mark.parametrize("key", POSITIVE + ["beam.poisson_ratio", "contact.start"])
+@pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf])
+def test_non_finite(key, value):
+    assert _error(_with(key, value)).startswith(f"{key}: must be finite")
+
+
+@pytest.mark.parametrize("key, value, rule", [
+    ("beam.length", "1 m", "must be a number"),
+    ("beam.height", True, "must be a number"),
+    ("physics.inertia", 1, "must be true or false"),
+    ("contact.friction", "sticky", 'must be one of "stick" | "coulomb"'),
+    ("contact.friction", 1.0, "must be a string"),
+    ("numerics.elements", 10.5, "must be a whole number"),
+])
+def test_wrong_types(key, value, rule):
+    assert rule in _error(_with(key, value))
+
+
+@pytest.mark.parametrize("nu", [-1.0, 0.5, -1.5, 0.7])
+def test_poisson_ratio_open_interval(nu):
+    assert _error(_with("beam.poisson_ratio", nu)).startswith(
+        "beam.poisson_ratio: must lie in the open interval (-1.0, 0.5)")
+
+
+def test_contact_order_and_inside():
+    msg = _error(_with("contact.start", 0.7))
+    assert msg.startswith("contact.start: must be < contact.end")
+    assert _error(_with("contact.start", 0.0)).startswith("contact.start/end: the contact "
+                                                          "must lie inside the beam")
+    assert _error(_with("contact.end", 1.0)).startswith("contact.start/end")
+
+
+@pytest.mark.parametrize("speed, which", [(182.6, "tension"), (130.0, "bending"),
+                                          (129.1, "bending")])
+def test_critical_speeds(speed, which):
+    """Both critical speeds quoted: sqrt(b1/rho) = 182.574, sqrt(a/I) = 129.099 m/s."""
+    d = _with("motion.belt_speed", speed)
+    b1, rho = 5e7 * 0.1 * 0.1, 1500 * 0.01
+    a, inertia = 5e7 * 0.1 * 1e-3 / 12, 1500 * 0.01 * 0.02 / 12
+    msg = _error(d)
+    assert msg.startswith("motion.belt_speed: must stay below both critical speeds")
+    assert f"{math.sqrt(b1 / rho):.6g}" in msg and f"{math.sqrt(a / inertia):.6g}" in msg
+    # a quasistatic scene has no inertia terms, hence no critical speed
+    Scene.from_dict(_with("physics.inertia", False, d))
+
+
+def test_keys_a_scene_does_not_need():
+    stick = _with("contact.friction", "stick")
+    assert _error(stick).startswith('contact.max_friction: only for contact.friction = '
+                                    '"coulomb"')
+    assert _error(_with("contact.max_friction", _DELETE)).startswith(
+        "contact.max_friction: missing key")
+    qs = _with("physics.inertia", False)
+    assert _error(_with("stiffness.mass", 10.0, qs)).startswith(
+        "stiffness.mass: only for physics.inertia = true")
+    assert _error(_with("numerics.adhesion_layer", 1e-6)).startswith(
+        "numerics.adhesion_layer: only for contact.friction = \"stick\"")
+    assert _error(_with("numerics.integrator", "explicit", qs)).startswith(
+        "numerics.integrator: \"explicit\" needs physics.inertia = true")
+    # a quasistatic scene needs no density
+    Scene.from_dict(_with("beam.density", _DELETE, qs))
+
+
+def test_stiffness_overrides_take_effect():
+    s = Scene.from_dict(_with("stiffness.shear", 1234.0))
+    assert s.params.b2 == 1234.0
+    assert s.params.b1 == 5e7 * 0.1 * 0.1
+
+
+def test_set_overrides():
+    s = load_scene("runs/paper_slip.toml", ["contact.max_friction=2e5",
+                                             "contact.friction=coulomb"])
+    assert s.params.fstar == 2e5
+    with pytest.raises(SceneError, match=r"^contact\.nope: unknown key"):
+        load_scene("runs/paper_slip.toml", ["contact.nope=1"])
+    with pytest.raises(SceneError, match=r"^nope\.x: unknown section"):
+        load_scene("runs/paper_slip.toml", ["nope.x=1"])
+    with pytest.raises(SceneError, match=r"^contact\.max_friction: must be > 0"):
+        load_scene("runs/paper_slip.toml", ["contact.max_friction=-5"])
+    with pytest.raises(SceneError, match=r"^contact\.max_friction: must be finite"):
+        load_scene("runs/paper_slip.toml", ["contact.max_friction=nan"])
+    with pytest.raises(SceneError, match=r"expected SECTION\.KEY=VALUE"):
+        load_scene("runs/paper_slip.toml", ["contact.max_friction"])
+    with pytest.raises(SceneError, match=r"cannot parse value"):
+        load_scene("runs/paper_slip.toml", ["beam.length=1..2"])
+
+
+def test_files(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[beam\nlength = 1\n")
+    with pytest.raises(SceneError, match="malformed TOML"):
+        load_scene(bad)
+    with pytest.raises(SceneError, match="scene file not found"):
+        load_scene(tmp_path / "missing.toml")
+    with pytest.raises(SceneError, match="is a directory"):
+        load_scene(tmp_path)
+    binary = tmp_path / "bin.toml"
+    binary.write_bytes(b"\xff\xfe\x00")
+    with pytest.raises(SceneError, match="not a UTF-8"):
+        load_scene(binary)
+
+
+def test_round_trip_through_toml():
+    s = load_scene("runs/paper_slip.toml", ["numerics.elements=300"])
+    again = Scene(tomllib.loads(s.to_toml()))
+    assert again.to_dict() == s.to_dict()
