@@ -135,8 +135,9 @@ def cmd_convergence(args):
     ladder = _int_list(args.ladder, "--ladder")
     schemes = args.schemes.split(",") if args.schemes else None
     for s in schemes or ():
-        if s not in ("explicit", "implicit", "steady"):
-            raise UsageError(f"--schemes: unknown scheme {s!r} (explicit, implicit, steady)")
+        if s not in ("explicit", "implicit", "steady", "richardson"):
+            raise UsageError(f"--schemes: unknown scheme {s!r} "
+                             f"(explicit, implicit, steady, richardson)")
     cols = ("scheme", "elements", "h_min", "dt", "steps", "wall_time", "compile_time",
             "converged") + tuple(f"error_{k}" for k in studies.ERROR_KEYS)
     print("  ".join(f"{c:>12s}" for c in cols))
@@ -305,7 +306,7 @@ def build_parser():
     p.add_argument("--ladder", default="125,250,500,1000,2000",
                    help="element counts (comma-separated)")
     p.add_argument("--schemes", default=None,
-                   help="comma-separated subset of explicit,implicit,steady")
+                   help="comma-separated subset of explicit,implicit,steady,richardson")
     p.set_defaults(func=cmd_convergence)
 
     p = sub.add_parser("paper", help="the paper's Table 1 and Figures 2-7 (analytic, with "

@@ -90,3 +90,11 @@ def make_grid(L: float, x1: float, x2: float, elements: int, grading: float = 1.
     if np.any(np.diff(x) <= 0.0):
         raise SceneError("numerics.elements: too few elements for this grading and geometry")
     return Grid(x=x, j1=j1, j2=j2)
+
+
+def bisect(grid: Grid) -> Grid:
+    """The grid with every element halved: nested, so coarse nodes are fine nodes."""
+    mid = 0.5 * (grid.x[1:] + grid.x[:-1])
+    x = np.empty(2 * len(grid.x) - 1)
+    x[0::2], x[1::2] = grid.x, mid
+    return Grid(x=x, j1=2 * grid.j1, j2=2 * grid.j2)

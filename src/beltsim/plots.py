@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 SCHEME_STYLE = {"explicit": ("tab:red", "s"), "implicit": ("tab:blue", "o"),
-                "steady": ("tab:green", "^")}
+                "steady": ("tab:green", "^"), "richardson": ("tab:purple", "D")}
 
 
 def _pyplot():
@@ -30,7 +30,9 @@ def error_vs_runtime(rows, path, title=""):
                         xytext=(4, 4), fontsize=7, color=color)
     ax.set_xlabel("wall time to steady state [s] (numba compilation excluded)")
     ax.set_ylabel("relative error of the total friction")
-    ax.set_title(title or "Error against run time (labels: elements)")
+    import textwrap
+    ax.set_title(textwrap.fill(f"{title} (labels: elements)" if title else
+                               "Error against run time (labels: elements)", 70), fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.savefig(path, dpi=130)

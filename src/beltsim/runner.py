@@ -8,6 +8,7 @@ the progress bar.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import tomllib
 from dataclasses import dataclass, field
@@ -63,11 +64,13 @@ class RunResult:
 class Simulation:
     """A scene on its grid, from rest. ``run()`` steps it to steady state."""
 
-    def __init__(self, scene: Scene):
+    def __init__(self, scene: Scene, grid=None):
         self.scene = scene
         self.params = scene.params
         self.numerics = resolve(scene)
-        self.grid = build_grid(scene, self.numerics)
+        if grid is not None:  # a given grid (e.g. a bisected one); elements follow it
+            self.numerics = dataclasses.replace(self.numerics, elements=grid.n_elements)
+        self.grid = grid if grid is not None else build_grid(scene, self.numerics)
         if self.numerics.integrator == "explicit":
             self.numerics = with_explicit_step(scene, self.numerics, self.grid)
         self.prm, self.iprm = pack(self.params, self.numerics, self.grid)
