@@ -251,6 +251,42 @@ def cmd_paper(args):
     return 0
 
 
+def cmd_animate(args):
+    from pathlib import Path
+
+    from .animate import animate
+    from .results import SNAPSHOTS, prepare_outdir, save_run
+    from .runner import run
+
+    if args.fps < 1:
+        raise UsageError(f"--fps: must be >= 1, got {args.fps}")
+    if args.from_dir:
+        if args.scene or args.overrides:
+            raise UsageError("--from DIR animates a stored run: give no SCENE or --set")
+        src = Path(args.from_dir)
+        out = prepare_outdir(args.out or src)
+    else:
+        if not args.scene:
+            raise UsageError("animate: give a SCENE file, or --from DIR")
+        scene = _scene(args)
+        P = scene.params
+        interval = args.interval or scene.numerics.get("snapshot_interval") or P.L / (4 * P.c)
+        if not interval > 0:
+            raise UsageError(f"--interval: must be > 0 s, got {interval}")
+        out = prepare_outdir(args.out or Path("runs/out") / f"animate_{Path(args.scene).stem}")
+        result = run(scene, progress=not args.quiet, raise_on_failure=False,
+                     snapshot_interval=interval)
+        save_run(result, out)
+        print(f"ran {args.scene}: {'steady' if result.converged else result.reason} at "
+              f"t = {result.simulated_time:.4g} s, {len(result.snapshots['t'])} snapshots")
+        src = out
+    if not (src / SNAPSHOTS).is_file():
+        raise UsageError(f"--from {src}: no {SNAPSHOTS} there (run with --snapshots INTERVAL)")
+    path = animate(src / SNAPSHOTS, out / f"transient.{args.format}", args.format, args.fps)
+    print(f"wrote {path}")
+    return 0
+
+
 def _int_list(text, name):
     try:
         vals = [int(v) for v in text.split(",")]
@@ -315,6 +351,21 @@ def build_parser():
     p.add_argument("--no-sim", action="store_true",
                    help="analytic curves only, no simulated markers")
     p.set_defaults(func=cmd_paper)
+
+    p = sub.add_parser("animate", help="animated transient (GIF or MP4) of a scene or a "
+                       "stored run")
+    p.add_argument("scene", nargs="?", help="scene file (TOML) to run")
+    p.add_argument("--set", dest="overrides", action="append", default=[],
+                   metavar="SECTION.KEY=VALUE", help="override a scene key (repeatable)")
+    p.add_argument("--from", dest="from_dir", metavar="DIR", default=None,
+                   help="animate DIR/snapshots.npz of a stored run, without running")
+    p.add_argument("--out", default=None, help="output directory")
+    p.add_argument("--format", choices=("gif", "mp4"), default="gif")
+    p.add_argument("--fps", type=int, default=15, help="frames per second")
+    p.add_argument("--interval", type=float, default=None,
+                   help="simulated seconds between snapshots (default L / (4 c))")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_animate)
 
     p = sub.add_parser("sweep", help="run a scene for several values of one key, in "
                        "parallel")

@@ -24,6 +24,16 @@ from .grid import Grid
 from .scene import Params
 
 
+def nodal_slope(values, he):
+    """d/dx at the nodes: the mean of the two adjacent elements' slopes (one at the ends).
+
+    Works on the last axis, so a stack of snapshots goes through at once.
+    """
+    e = np.diff(values, axis=-1) / he
+    return np.concatenate([e[..., :1], 0.5 * (e[..., 1:] + e[..., :-1]), e[..., -1:]],
+                          axis=-1)
+
+
 LAYER, FIT = 3, 3  # elements of the discrete force layer at x2, and of the smooth fit
 
 
@@ -57,10 +67,7 @@ class DiscreteSolution:
     def fields(self) -> dict:
         """Nodal fields with the analytic header: strain and moment averaged from elements."""
         P, he = self.params, self.grid.he
-        eps_e = np.diff(self.u) / he
-        kap_e = np.diff(self.theta) / he
-        strain = np.concatenate([[eps_e[0]], 0.5 * (eps_e[1:] + eps_e[:-1]), [eps_e[-1]]])
-        kappa = np.concatenate([[kap_e[0]], 0.5 * (kap_e[1:] + kap_e[:-1]), [kap_e[-1]]])
+        strain, kappa = nodal_slope(self.u, he), nodal_slope(self.theta, he)
         return {"u": self.u, "theta": self.theta, "strain": strain,
                 "tension": P.b1 * strain, "moment": P.a * kappa, "friction": self.traction}
 

@@ -1,0 +1,53 @@
+"""Animated transients from a run's snapshot file."""
+
+import subprocess
+import sys
+
+import numpy as np
+from PIL import Image
+
+from beltsim.animate import frame_fields
+from beltsim.results import read_snapshots
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "beltsim.cli", *args], capture_output=True,
+                          text=True, timeout=600)
+
+
+def test_animate_runs_and_stores_a_gif_then_mp4_from_the_stored_run(tmp_path):
+    run_dir = tmp_path / "run"
+    proc = _cli("animate", "runs/paper_slip.toml", "--set", "numerics.elements=150",
+                "--interval", "0.01", "--fps", "5", "--out", str(run_dir), "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    gif = Image.open(run_dir / "transient.gif")
+    assert gif.n_frames > 5
+    stamp = (run_dir / "summary.json").stat().st_mtime_ns
+    out = tmp_path / "mp4"
+    proc = _cli("animate", "--from", str(run_dir), "--format", "mp4", "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    data = (out / "transient.mp4").read_bytes()
+    assert len(data) > 10_000 and data[4:8] == b"ftyp"
+    assert (run_dir / "summary.json").stat().st_mtime_ns == stamp  # no new run
+
+
+def test_snapshots_settle_on_the_stored_final_state(tmp_path):
+    proc = _cli("run", "runs/paper_inertia.toml", "--set", "numerics.elements=150",
+                "--snapshots", "0.005", "--out", str(tmp_path), "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    snaps = read_snapshots(tmp_path / "snapshots.npz")
+    assert snaps["t"][0] == 0.0 and np.all(np.diff(snaps["t"]) > 0)
+    fields = frame_fields(snaps)
+    assert np.all(fields["u"][0] == 0)  # from rest
+    final = np.loadtxt(tmp_path / "fields.csv", delimiter=",", skiprows=1)
+    # the last snapshot is the final state, in single precision
+    np.testing.assert_allclose(fields["u"][-1], final[:, 1], rtol=1e-6,
+                               atol=1e-7 * np.abs(final[:, 1]).max())
+    np.testing.assert_allclose(fields["tension"][-1], final[:, 4], rtol=1e-5,
+                               atol=1e-5 * np.abs(final[:, 4]).max())
+
+
+def test_missing_snapshots_is_a_clean_error(tmp_path):
+    proc = _cli("animate", "--from", str(tmp_path))
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1
+    assert "snapshots.npz" in proc.stderr and "Traceback" not in proc.stderr
