@@ -17,8 +17,8 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
-def _add_scene_args(p):
-    p.add_argument("scene", help="scene file (TOML)")
+def _add_scene_args(p, **scene_kw):
+    p.add_argument("scene", **({"help": "scene file (TOML)"} | scene_kw))
     p.add_argument("--set", dest="overrides", action="append", default=[],
                    metavar="SECTION.KEY=VALUE", help="override a scene key (repeatable)")
 
@@ -323,9 +323,7 @@ def build_parser():
     p.set_defaults(func=cmd_analytic)
 
     p = sub.add_parser("run", help="transient simulation from rest to steady state")
-    p.add_argument("scene", nargs="?", help="scene file (TOML)")
-    p.add_argument("--set", dest="overrides", action="append", default=[],
-                   metavar="SECTION.KEY=VALUE", help="override a scene key (repeatable)")
+    _add_scene_args(p, nargs="?")
     p.add_argument("--out", default=None, help="output directory (default runs/out/SCENE)")
     p.add_argument("--resume", metavar="DIR", default=None,
                    help="continue an interrupted run from DIR/checkpoint.npz")
@@ -354,9 +352,7 @@ def build_parser():
 
     p = sub.add_parser("animate", help="animated transient (GIF or MP4) of a scene or a "
                        "stored run")
-    p.add_argument("scene", nargs="?", help="scene file (TOML) to run")
-    p.add_argument("--set", dest="overrides", action="append", default=[],
-                   metavar="SECTION.KEY=VALUE", help="override a scene key (repeatable)")
+    _add_scene_args(p, nargs="?", help="scene file (TOML) to run")
     p.add_argument("--from", dest="from_dir", metavar="DIR", default=None,
                    help="animate DIR/snapshots.npz of a stored run, without running")
     p.add_argument("--out", default=None, help="output directory")
@@ -388,9 +384,8 @@ def build_parser():
 
     p = sub.add_parser("bench", help="paper slip scene: ours against a solve_ivp peer, "
                        "explicit kernel speed, cold start")
-    p.add_argument("scene", nargs="?", default="runs/paper_slip.toml")
-    p.add_argument("--set", dest="overrides", action="append", default=[],
-                   metavar="SECTION.KEY=VALUE")
+    _add_scene_args(p, nargs="?", default="runs/paper_slip.toml",
+                    help="scene file (TOML; default runs/paper_slip.toml)")
     p.add_argument("--no-peer", action="store_true", help="skip the solve_ivp peer")
     p.add_argument("--no-cold", action="store_true", help="skip the cold-start run")
     p.set_defaults(func=cmd_bench)
