@@ -57,7 +57,8 @@ class Workspace:
 
 
 # How far above newton_tol a stalled Newton update may be and still count as
-# converged: 1e3 * 1e-9 keeps it three orders below the finest grid's error.
+# converged: 1e3 * 1e-9 = 1e-6, an order below the discretisation error of the finest
+# grid tried (1.4e-5 on 20,000 elements).
 ROUNDOFF_FLOOR = 1e3
 
 
