@@ -10,15 +10,16 @@ A few lines do what the CLI does::
     beltsim.save_run(result, "runs/out/slip")
 """
 
-from .analytic import AnalyticSolution, solve
 from .errors import BeltsimError, NoSolutionError, NumericalError, SceneError
-from .results import save_run
-from .runner import RunResult, Simulation, run
-from .scene import Scene, load_scene
+from .io.results import save_run
+from .problem.analytic import AnalyticSolution, solve
+from .problem.scene import Scene, load_scene
+from .simulation.controller import Simulation, run
+from .simulation.result import RunResult, RunStatus
 
 __version__ = "0.1.0"
 
 __all__ = [
     "AnalyticSolution", "BeltsimError", "NoSolutionError", "NumericalError", "RunResult",
-    "Scene", "SceneError", "Simulation", "load_scene", "run", "save_run", "solve",
+    "RunStatus", "Scene", "SceneError", "Simulation", "load_scene", "run", "save_run", "solve",
 ]

@@ -24,7 +24,7 @@ def _add_scene_args(p, **scene_kw):
 
 
 def _scene(args):
-    from .scene import load_scene
+    from .problem.scene import load_scene
     return load_scene(args.scene, args.overrides)
 
 
@@ -33,8 +33,9 @@ def _scene(args):
 
 
 def cmd_analytic(args):
-    from . import analytic
-    from .results import prepare_outdir, write_fields, write_json
+    from .io.files import prepare_outdir, write_json
+    from .io.results import write_fields
+    from .problem import analytic
 
     scene = _scene(args)
     sol = analytic.solve(scene)
@@ -66,9 +67,13 @@ def format_summary(summary: dict, title: str = "") -> str:
 def cmd_run(args):
     from pathlib import Path
 
-    from .results import prepare_outdir, save_run, write_atomic
-    from .runner import Simulation
+    from .io.files import prepare_outdir, write_atomic
+    from .io.results import CHECKPOINT, save_run
+    from .simulation.controller import Simulation
+    from .simulation.result import reference_of
 
+    if args.snapshots is not None and not args.snapshots > 0:
+        raise UsageError(f"--snapshots: must be > 0 s, got {args.snapshots}")
     if args.resume:
         if args.scene or args.overrides:
             raise UsageError("--resume DIR continues a run as it was: give no SCENE or --set")
@@ -80,37 +85,30 @@ def cmd_run(args):
             raise UsageError("run: give a SCENE file, or --resume DIR")
         scene = _scene(args)
         out = prepare_outdir(args.out or Path("runs/out") / Path(args.scene).stem)
-        sim = Simulation(scene)
+        sim = Simulation(scene, snapshot_interval=args.snapshots)
         title = scene.title or args.scene
     # a summary.json present means the latest run in this directory finished
     (out / "summary.json").unlink(missing_ok=True)
-    if args.snapshots is not None and not args.snapshots > 0:
-        raise UsageError(f"--snapshots: must be > 0 s, got {args.snapshots}")
     result = sim.run(progress=not args.quiet, raise_on_failure=False, handle_signals=True,
-                     snapshot_interval=args.snapshots)
+                     checkpoint=out / CHECKPOINT)
     if result.interrupted:
-        sim.save_checkpoint(out / CHECKPOINT)
         write_atomic(out / "scene.toml", sim.scene.to_toml())
         print(f"beltsim: {result.reason}; checkpoint written, continue with "
               f"'beltsim run --resume {out}'", file=sys.stderr)
         return 130
+    result.reference = reference_of(sim.scene)
     save_run(result, out)
     summary = result.summary()
     print(format_summary(summary, title=title))
     print(format_run(summary))
     print(f"wrote {out}/summary.json, fields.csv, history.csv")
     if result.failed:
-        sim.save_checkpoint(out / CHECKPOINT)  # the last good state
         print(f"beltsim: numerical failure: {result.reason}", file=sys.stderr)
         return 3
-    (out / CHECKPOINT).unlink(missing_ok=True)
     if not result.converged:
         print(f"beltsim: warning: {result.reason}", file=sys.stderr)
         return 1
     return 0
-
-
-CHECKPOINT = "checkpoint.npz"
 
 
 def format_run(summary: dict) -> str:
@@ -127,17 +125,19 @@ def format_run(summary: dict) -> str:
 def cmd_convergence(args):
     from pathlib import Path
 
-    from . import plots, studies
-    from .results import prepare_outdir, write_csv
+    from . import solvers
+    from .io.files import prepare_outdir, write_csv
+    from .plots.studies import error_vs_runtime
+    from .studies import convergence as studies
 
     scene = _scene(args)
     out = prepare_outdir(args.out or Path("runs/out") / f"convergence_{Path(args.scene).stem}")
     ladder = _int_list(args.ladder, "--ladder")
     schemes = args.schemes.split(",") if args.schemes else None
+    known = (*solvers.names(), studies.RICHARDSON)
     for s in schemes or ():
-        if s not in ("explicit", "implicit", "steady", "richardson"):
-            raise UsageError(f"--schemes: unknown scheme {s!r} "
-                             f"(explicit, implicit, steady, richardson)")
+        if s not in known:
+            raise UsageError(f"--schemes: unknown scheme {s!r} ({', '.join(known)})")
     cols = ("scheme", "elements", "h_min", "dt", "steps", "wall_time", "compile_time",
             "converged") + tuple(f"error_{k}" for k in studies.ERROR_KEYS)
     print("  ".join(f"{c:>12s}" for c in cols))
@@ -145,10 +145,9 @@ def cmd_convergence(args):
     def show(row):
         print("  ".join(_cell(row[c]) for c in cols), flush=True)
     rows = studies.convergence(scene, ladder, schemes, progress=show)
-    write_csv(out / "convergence.csv", cols,
-              [[_num(r[c]) for r in rows] for c in cols], text_columns={"scheme"})
-    plots.error_vs_runtime(rows, out / "error_vs_runtime.png",
-                           title=f"{scene.title or args.scene}")
+    write_csv(out / "convergence.csv", cols, [[r[c] for r in rows] for c in cols],
+              text_columns={"scheme"})
+    error_vs_runtime(rows, out / "error_vs_runtime.png", title=f"{scene.title or args.scene}")
     print("observed order in the grid size (successive grids; least-squares fit):")
     for key in studies.ERROR_KEYS:
         for scheme, o in studies.observed_orders(rows, key).items():
@@ -159,7 +158,7 @@ def cmd_convergence(args):
 
 
 def cmd_bench(args):
-    from . import studies
+    from .studies import bench as studies
 
     result = studies.bench(args.scene, args.overrides, peer=not args.no_peer,
                            cold=not args.no_cold)
@@ -170,25 +169,27 @@ def cmd_bench(args):
 def cmd_stability(args):
     from pathlib import Path
 
-    from . import studies
-    from .results import prepare_outdir, write_atomic, write_csv
+    from .io.files import prepare_outdir, write_atomic, write_csv
+    from .studies import stability as studies
+    from .studies.convergence import ERROR_KEYS
 
     out = prepare_outdir(args.out or Path("runs/out/stability"))
     extra = [f"numerics.elements={args.elements}"] if args.elements else []
     cases = studies.STABILITY_CASES
-    if args.elements:  # a coarse matrix: the fine-grid case is the default one coarsened
-        cases = tuple(c for c in cases if "numerics.elements=20000" not in c[2])
+    if args.elements:  # a coarse matrix: a case about the grid is the others coarsened
+        cases = tuple(c for c in cases if not c.sets_grid)
     cols = ("case", "scheme", "status", "dt", "steps", "wall_time") + tuple(
-        f"error_{k}" for k in studies.ERROR_KEYS) + ("reason",)
+        f"error_{k}" for k in ERROR_KEYS) + ("reason",)
 
     def show(row):
-        print(f"{row['case']:<40s} {row['scheme']:<9s} {row['status']:<15s} "
+        print(f"{row['case']:<40s} {row['scheme']:<9s} {row['status'].value:<15s} "
               f"wall {row['wall_time']:.3g} s  {row['reason'][:90]}", flush=True)
     rows = studies.stability_matrix(cases, extra=extra, progress=show)
-    write_csv(out / "stability.csv", cols, [[r[c] for r in rows] for c in cols],
+    write_csv(out / "stability.csv", cols,
+              [[r[c].value if c == "status" else r[c] for r in rows] for c in cols],
               text_columns={"case", "scheme", "status", "reason"})
     write_atomic(out / "stability.md", studies.stability_markdown(rows))
-    bad = [r for r in rows if r["status"] not in ("converged", "refused", "not applicable")]
+    bad = [r for r in rows if r["status"] not in studies.ACCEPTED]
     print(f"wrote {out / 'stability.csv'} and {out / 'stability.md'}; "
           f"{len(rows) - len(bad)} of {len(rows)} cells converged, refused or not applicable")
     return 1 if bad else 0
@@ -199,8 +200,9 @@ def cmd_sweep(args):
 
     import numpy as np
 
-    from . import analytic, plots, sweep
-    from .results import prepare_outdir, write_csv
+    from .io.files import prepare_outdir, write_csv
+    from .plots.studies import creep_collapse
+    from .studies import sweep
 
     scene = _scene(args)
     key, values = sweep.parse_vary(args.vary)
@@ -223,13 +225,7 @@ def cmd_sweep(args):
     write_csv(out / "sweep.csv", cols, data)
     print(f"wrote {out / 'sweep.csv'}")
     if collapse:
-        P = scene.params
-        for r in rows:
-            sc = scene.with_overrides([(key, r["value"])])
-            xs, f = analytic.solve(sc).sample(801)
-            r.update(x2=P.x2, x_exact=xs, theta_exact=f["theta"],
-                     theta_adhesion=analytic.solve(sc, model="stick").fields(xs)["theta"])
-        plots.creep_collapse(rows, out / "creep_collapse.png", title=scene.title)
+        creep_collapse(rows, out / "creep_collapse.png", title=scene.title)
         print(f"wrote {out / 'creep_collapse.png'}")
     return 0 if all(r["converged"] for r in rows) else 1
 
@@ -237,7 +233,7 @@ def cmd_sweep(args):
 def cmd_paper(args):
     from pathlib import Path
 
-    from . import paper
+    from .studies import paper
 
     sims = None
     if not args.no_sim:
@@ -254,9 +250,10 @@ def cmd_paper(args):
 def cmd_animate(args):
     from pathlib import Path
 
-    from .animate import animate
-    from .results import SNAPSHOTS, prepare_outdir, save_run
-    from .runner import run
+    from .io.files import prepare_outdir
+    from .io.results import SNAPSHOTS, save_run
+    from .plots.animate import animate
+    from .simulation.controller import run
 
     if args.fps < 1:
         raise UsageError(f"--fps: must be >= 1, got {args.fps}")
@@ -288,19 +285,15 @@ def cmd_animate(args):
 
 
 def _int_list(text, name):
+    from .physics.grid import MIN_ELEMENTS
+
     try:
         vals = [int(v) for v in text.split(",")]
     except ValueError:
         raise UsageError(f"{name}: expected comma-separated whole numbers, got {text!r}") from None
-    if any(v < 6 for v in vals):
-        raise UsageError(f"{name}: every grid needs at least 6 elements")
+    if any(v < MIN_ELEMENTS for v in vals):
+        raise UsageError(f"{name}: every grid needs at least {MIN_ELEMENTS} elements")
     return vals
-
-
-def _num(v):
-    if isinstance(v, bool):
-        return float(v)
-    return v
 
 
 def _cell(v):
@@ -340,7 +333,7 @@ def build_parser():
     p.add_argument("--ladder", default="125,250,500,1000,2000",
                    help="element counts (comma-separated)")
     p.add_argument("--schemes", default=None,
-                   help="comma-separated subset of explicit,implicit,steady,richardson")
+                   help="comma-separated subset of the registered schemes and richardson")
     p.set_defaults(func=cmd_convergence)
 
     p = sub.add_parser("paper", help="the paper's Table 1 and Figures 2-7 (analytic, with "

@@ -12,10 +12,11 @@ from __future__ import annotations
 import os
 from concurrent.futures import Executor, ProcessPoolExecutor
 
-from .errors import BeltsimError, UsageError
-from .scene import Scene, parse_assignment, set_key
+from ..errors import UsageError
+from ..problem.scene import Scene, parse_assignment, set_key
 
 KEYS = ("total_friction", "stick_friction", "slip_friction", "slip_start")
+EXACT_SAMPLES = 801  # points of the exact fields kept for a figure
 
 
 def parse_vary(text: str):
@@ -30,26 +31,33 @@ def parse_vary(text: str):
     return key.strip(), values
 
 
-def run_point(scene_dict: dict, key: str, value, snapshot_fields=False) -> dict:
-    """One sweep point (module level, so worker processes can run it)."""
-    from . import analytic
-    from .runner import Simulation
+def run_point(scene_dict: dict, key: str, value, keep_theta=False) -> dict:
+    """One sweep point (module level, so worker processes can run it).
+
+    The exact solutions of the point are computed once here: the scene's own and, for
+    Coulomb friction, its perfect-adhesion limit. ``keep_theta`` adds the simulated and
+    exact rotation fields (for the creep-collapse figure).
+    """
+    from ..simulation.controller import Simulation
+    from ..simulation.result import reference_of
 
     scene = Scene(scene_dict).with_overrides([(key, value)])
     res = Simulation(scene).run(raise_on_failure=False)
     sim = res.solution.summary()
     row = {"value": value, **{k: sim.get(k) for k in KEYS}}
-    ref = res.reference
+    ref = reference_of(scene)
     exact = ref.summary() if ref is not None else {}
     row.update({f"{k}_analytic": exact.get(k) for k in KEYS})
-    if scene.params.friction == "coulomb":
-        adhesion = analytic.solve(scene, model="stick")
-        row["total_friction_adhesion"] = adhesion.total_friction
+    adhesion = reference_of(scene, model="stick") if scene.params.friction == "coulomb" else None
+    row["total_friction_adhesion"] = adhesion.total_friction if adhesion else None
     row.update(converged=res.converged, wall_time=res.wall_time, reason=res.reason,
-               h_min=res.solution.grid.h_min)
-    if snapshot_fields:
-        row["x"] = res.solution.x
-        row["theta"] = res.solution.theta
+               h_min=res.solution.grid.h_min, x2=scene.params.x2)
+    if keep_theta:
+        row.update(x=res.solution.x, theta=res.solution.theta)
+        if ref is not None and adhesion is not None:
+            x_exact, fields = ref.sample(EXACT_SAMPLES)
+            row.update(x_exact=x_exact, theta_exact=fields["theta"],
+                       theta_adhesion=adhesion.fields(x_exact)["theta"])
     return row
 
 
@@ -84,8 +92,6 @@ def sweep(scene: Scene, key: str, values, executor: Executor | None = None,
             rows.append(f.result())
             if progress:
                 progress(rows[-1])
-    except BeltsimError:
-        raise
     finally:
         if own:
             executor.shutdown(cancel_futures=True)

@@ -12,9 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import analytic
-from .results import prepare_outdir, write_csv
-from .scene import paper_scene
+from ..io.files import prepare_outdir, write_csv
+from ..problem import analytic
+from ..problem.scene import paper_scene
 
 CASES = {"quasistatic": "No inertia, no slip", "inertia": "With inertia, no slip",
          "slip": "With inertia, with slip"}
@@ -69,7 +69,7 @@ def format_table1(rows) -> str:
 
 def simulate(progress=None) -> dict:
     """Simulated steady states of the cases (transient runs from rest, default numerics)."""
-    from .runner import run
+    from ..simulation.controller import run
 
     out = {}
     scenes = {name: paper_scene(name) for name in CASES}
@@ -91,85 +91,10 @@ def simulate(progress=None) -> dict:
     return out
 
 
-def _pyplot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
-
-
-def _markers(ax, sim, field, color):
-    if sim is None:
-        return
-    x, y = sim["x"], sim[field]
-    step = max(1, len(x) // 70)
-    ax.plot(x[::step], y[::step], "o", ms=3.5, mfc="none", color=color)
-
-
-def _shade_contact(ax, P):
-    ax.axvspan(P.x1, P.x2, color="0.92", zorder=0)
-
-
-def _two_panel(field, number, ylabel, title, sols, sims, path):
-    plt = _pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.3), constrained_layout=True)
-    for ax, cases, sub in zip(axes, PANELS, PANEL_TITLES):
-        _shade_contact(ax, sols["inertia"].params)
-        for case in cases:
-            color, label = STYLE[case]
-            s = sols[case]
-            x, f = s.sample(1201)
-            ax.plot(x, f[field], color=color, lw=1.6, label=label)
-            _markers(ax, sims.get(case), field, color)
-            if field == "friction" and s.model == "stick":
-                # a delta cannot be drawn as a curve: a stem with its value
-                top = 1.08 * max(np.max(np.abs(sols[c].sample(401)[1]["friction"]))
-                                 for c in cases)
-                ax.annotate(f"concentrated force\nF = {s.concentrated_force:.0f} N at x2",
-                            xy=(s.params.x2, top * 0.97),
-                            xytext=(s.params.x2 + 0.06, top * (0.8 if case == "inertia"
-                                                                else 0.5)),
-                            color=color, fontsize=9,
-                            arrowprops=dict(arrowstyle="->", color=color))
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel(ylabel)
-        ax.set_title(sub)
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8, loc="upper left")
-    note = " (lines: analytic; markers: simulated from rest)" if sims else ""
-    fig.suptitle(f"Fig. {number}. {title} over the spatial coordinate{note}", fontsize=11)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
-
-
-def _fig7(sols, sims, path):
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 4.6), constrained_layout=True)
-    _shade_contact(ax, sols["inertia"].params)
-    colors = ("tab:orange", "tab:red", "tab:purple")
-    for fs, color in zip(FIG7_FSTAR, colors):
-        key = f"slip_{fs:.0e}"
-        x, f = sols[key].sample(1201)
-        ax.plot(x, f["theta"], color=color, lw=1.4, label=f"slip, f* = {fs:.1e} N/m")
-        _markers(ax, sims.get(key), "theta", color)
-    x, f = sols["inertia"].sample(1201)
-    ax.plot(x, f["theta"], "k--", lw=1.6, label="perfect adhesion")
-    _markers(ax, sims.get("inertia"), "theta", "k")
-    ax.set_xlim(0.4, 0.8)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("angle theta [rad]")
-    ax.set_title("Fig. 7. Rotation angle: slip models converge to the stick model as f* "
-                 "grows", fontsize=10)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=9)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
-
-
 def reproduce(out_dir, simulated: dict | None = None) -> dict:
     """Write table1.csv and fig2.png ... fig7.png; returns the rows and the paths."""
+    from ..plots import paper as figures
+
     out = prepare_outdir(out_dir)
     sols = solutions()
     sims = simulated or {}
@@ -180,7 +105,7 @@ def reproduce(out_dir, simulated: dict | None = None) -> dict:
                                                        "distributed_or_sticking", "total")],
                        text_columns={"case"})]
     for field, number, ylabel, title in FIGURES:
-        paths.append(_two_panel(field, number, ylabel, title, sols, sims,
-                                Path(out) / f"fig{number}.png"))
-    paths.append(_fig7(sols, sims, Path(out) / "fig7.png"))
+        paths.append(figures.two_panel(field, number, ylabel, title, sols, sims,
+                                       Path(out) / f"fig{number}.png"))
+    paths.append(figures.fig7(sols, sims, Path(out) / "fig7.png"))
     return {"table": rows, "paths": paths}

@@ -12,7 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import SceneError
+from ..errors import SceneError
+
+
+#: The fewest elements of a grid: two in each of [0, x1], [x1, x2], [x2, L].
+MIN_ELEMENTS = 6
 
 
 @dataclass(frozen=True)
@@ -54,8 +58,8 @@ def make_grid(L: float, x1: float, x2: float, elements: int, grading: float = 1.
     ``refine_at`` adds further points (e.g. an expected slip start) towards which
     the grid is graded as towards x2.
     """
-    if elements < 6:
-        raise SceneError(f"numerics.elements: must be >= 6, got {elements}")
+    if elements < MIN_ELEMENTS:
+        raise SceneError(f"numerics.elements: must be >= {MIN_ELEMENTS}, got {elements}")
     if grading < 1.0:
         raise SceneError(f"numerics.grading: must be >= 1, got {grading}")
     centres = [x2, *refine_at]

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from .errors import NoSolutionError
+from ..errors import NoSolutionError
 from .scene import Params, Scene
 
 FIELDS = ("u", "theta", "strain", "tension", "moment", "friction")
@@ -52,7 +52,8 @@ class Segment:
         return self.q - self.p
 
 
-def _rates(P: Params):
+def decay_rates(P: Params):
+    """alpha and beta (1/m): theta decays as exp(-alpha x) in stick, exp(-beta x) elsewhere."""
     beta = math.sqrt(P.b2 / P.A)
     alpha = math.sqrt(4.0 * P.b2 / (4.0 * P.A + P.B * P.h**2))
     return alpha, beta
@@ -319,7 +320,7 @@ class AnalyticSolution:
 
 
 def _segments(P: Params, kinds_and_ends, s):
-    alpha, beta = _rates(P)
+    alpha, beta = decay_rates(P)
     out, p = [], 0.0
     for kind, q in kinds_and_ends:
         k = alpha if kind == "stick" else beta

@@ -1,23 +1,20 @@
-"""Plots of studies (figures of the paper live in paper.py, animation in animate.py)."""
+"""Figures of studies: error against run time, creep-zone collapse."""
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
+
+from .common import pyplot, save
 
 SCHEME_STYLE = {"explicit": ("tab:red", "s"), "implicit": ("tab:blue", "o"),
                 "steady": ("tab:green", "^"), "richardson": ("tab:purple", "D")}
 
 
-def _pyplot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
-
-
 def error_vs_runtime(rows, path, title=""):
     """Log-log error of the total friction against wall time, one line per scheme."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.6), constrained_layout=True)
     for scheme in dict.fromkeys(r["scheme"] for r in rows):
         rs = [r for r in rows if r["scheme"] == scheme and r["converged"]]
@@ -30,19 +27,16 @@ def error_vs_runtime(rows, path, title=""):
                         xytext=(4, 4), fontsize=7, color=color)
     ax.set_xlabel("wall time to steady state [s] (numba compilation excluded)")
     ax.set_ylabel("relative error of the total friction")
-    import textwrap
     ax.set_title(textwrap.fill(f"{title} (labels: elements)" if title else
                                "Error against run time (labels: elements)", 70), fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    return path
+    return save(fig, path, dpi=130)
 
 
 def creep_collapse(rows, path, title=""):
     """Three panels for a sweep over f*: slip-zone length, theta(x), total friction."""
-    plt = _pyplot()
+    plt = pyplot()
     fs = np.array([r["value"] for r in rows], dtype=float)
     x2 = rows[0]["x2"]
     sim_len = np.array([x2 - r["slip_start"] for r in rows])
@@ -91,6 +85,4 @@ def creep_collapse(rows, path, title=""):
     ax.grid(True, which="both", alpha=0.3)
     if title:
         fig.suptitle(title)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, path, dpi=110)

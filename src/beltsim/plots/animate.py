@@ -5,20 +5,20 @@ Reads the compact snapshot file of a run (``snapshots.npz``, see
 without running it again. Each frame shows the simulated fields, the contact zone,
 the analytic steady state (dashed) and the simulated time. Tension and moment come
 from the snapshots' u and theta as b1 du/dx and a dtheta/dx, with the nodal slopes
-of the run's own fields.csv (:func:`beltsim.solution.nodal_slope`).
+of the run's own fields.csv (:func:`beltsim.simulation.solution.stress_resultants`).
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from . import analytic
-from .results import OutputError, read_snapshots
-from .solution import nodal_slope
+from ..io.files import OutputError, atomic_path
+from ..io.results import read_snapshots
+from ..problem import analytic
+from ..simulation.solution import stress_resultants
+from .common import pyplot
 
 MAX_FRAMES = 150
 # (key, axis label) of the panels, top to bottom
@@ -33,8 +33,8 @@ def frame_fields(snaps: dict) -> dict:
     he = np.diff(snaps["x"])
     u = snaps["u"].astype(float)
     th = snaps["theta"].astype(float)
-    return {"friction": snaps["friction"].astype(float), "tension": P.b1 * nodal_slope(u, he),
-            "moment": P.a * nodal_slope(th, he), "theta": th, "u": u}
+    return {"friction": snaps["friction"].astype(float), **stress_resultants(P, u, th, he),
+            "theta": th, "u": u}
 
 
 def _limits(values, exact):
@@ -47,9 +47,9 @@ def _limits(values, exact):
 def animate(snapshots_path, out_path, fmt: str = "gif", fps: int = 15) -> Path:
     """Render the transient stored in ``snapshots_path`` to ``out_path`` (GIF or MP4)."""
     import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib import animation
+
+    plt = pyplot()
 
     if fmt not in ("gif", "mp4"):
         raise OutputError(f"--format: must be gif or mp4, got {fmt!r}")
@@ -109,23 +109,17 @@ def animate(snapshots_path, out_path, fmt: str = "gif", fps: int = 15) -> Path:
         return [*lines.values(), marks, stamp]
 
     out_path = Path(out_path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{out_path.stem}.", suffix=f".{fmt}",
-                               dir=out_path.parent)
-    os.close(fd)
     try:
-        anim = animation.FuncAnimation(fig, draw, frames=frames, blit=False)
-        if fmt == "gif":
-            writer = animation.PillowWriter(fps=fps)
-        else:
-            import imageio_ffmpeg
-            matplotlib.rcParams["animation.ffmpeg_path"] = imageio_ffmpeg.get_ffmpeg_exe()
-            writer = animation.FFMpegWriter(fps=fps, codec="libx264",
-                                            extra_args=["-pix_fmt", "yuv420p"])
-        anim.save(tmp, writer=writer, dpi=80)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, out_path)
+        with atomic_path(out_path, suffix=f".{fmt}") as tmp:
+            anim = animation.FuncAnimation(fig, draw, frames=frames, blit=False)
+            if fmt == "gif":
+                writer = animation.PillowWriter(fps=fps)
+            else:
+                import imageio_ffmpeg
+                matplotlib.rcParams["animation.ffmpeg_path"] = imageio_ffmpeg.get_ffmpeg_exe()
+                writer = animation.FFMpegWriter(fps=fps, codec="libx264",
+                                                extra_args=["-pix_fmt", "yuv420p"])
+            anim.save(tmp, writer=writer, dpi=80)
     finally:
         plt.close(fig)
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     return out_path

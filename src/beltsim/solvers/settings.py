@@ -26,18 +26,15 @@ Defaults (all overridable in [numerics]):
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
-import numpy as np
 
-from .errors import SceneError
-from .friction import LAW_CODES, LINEAR, has_dual
-from .grid import Grid, make_grid
-from .model import (I_DUAL, I_J1, I_J2, I_LAW, N_IPRM, N_PRM, P_A, P_B, P_B2, P_C, P_DAMP, P_DV, P_FS, P_HH,
-                    P_I, P_RHO, P_TRAMP, P_VREG)
-from .scene import Params, Scene
+from ..errors import SceneError
+from ..physics.friction import LAW_CODES
+from ..physics.grid import Grid, make_grid
+from ..problem.analytic import decay_rates
+from ..problem.scene import Params, Scene
 
 DEFAULT_ELEMENTS = 1000
 DEFAULT_GRADING = 8.0
@@ -117,60 +114,10 @@ def resolve(scene: Scene) -> Numerics:
 
 def default_elements(P: Params) -> int:
     """1000, or more when the scene's boundary layers are thinner than the paper's."""
-    beta = math.sqrt(P.b2 / P.A)
-    alpha = math.sqrt(4.0 * P.b2 / (4.0 * P.A + P.B * P.h**2))
+    alpha, beta = decay_rates(P)
     return max(DEFAULT_ELEMENTS, math.ceil(ELEMENTS_PER_LAYER * P.L * max(alpha, beta)))
 
 
 def build_grid(scene: Scene, num: Numerics) -> Grid:
     P = scene.params
     return make_grid(P.L, P.x1, P.x2, num.elements, num.grading)
-
-
-EXPLICIT_SAFETY = 0.9  # default explicit step as a fraction of the stability limit
-
-
-def with_explicit_step(scene: Scene, num: Numerics, grid: Grid) -> Numerics:
-    """Set the explicit step from the stability limit; refuse a requested step above it."""
-    from .integrators import explicit_stable_dt
-
-    P = scene.params
-    limit = explicit_stable_dt(P, grid.h_min, num.damping)
-    cfl = grid.h_min / (P.c + max(math.sqrt(P.b1 / P.rho), math.sqrt(P.a / P.I)))
-    if limit < 0.05 * cfl:
-        raise SceneError(
-            f"numerics.damping: the explicit scheme is unstable with damping = "
-            f"{num.damping:.6g} 1/s on this grid (its explicit gyroscopic term in the rotation "
-            f"equation needs damping); use the default damping or the implicit integrator")
-    requested = scene.numerics.get("dt")
-    if requested is not None and requested > limit:
-        raise SceneError(
-            f"numerics.dt: {requested:.6g} s exceeds the explicit stability limit "
-            f"{limit:.6g} s (characteristic speeds c + sqrt(b1/rho), c + sqrt(a/I) on the "
-            f"smallest element, {grid.h_min:.3g} m, with the gyroscopic and shear terms)")
-    dt = requested if requested is not None else EXPLICIT_SAFETY * limit
-    return dataclasses.replace(num, dt=dt)
-
-
-def pack(P: Params, num: Numerics, grid: Grid):
-    """Float and int parameter vectors for the kernels."""
-    prm = np.zeros(N_PRM)
-    prm[P_B], prm[P_A], prm[P_B2] = P.B, P.A, P.b2
-    prm[P_RHO], prm[P_I], prm[P_C], prm[P_HH] = P.rho, P.I, P.c, 0.5 * P.h
-    prm[P_DAMP], prm[P_FS], prm[P_VREG] = num.damping, num.fs, num.vreg
-    prm[P_DV], prm[P_TRAMP] = P.v - P.c, num.ramp_time
-    iprm = np.zeros(N_IPRM, dtype=np.int64)
-    iprm[I_LAW], iprm[I_J1], iprm[I_J2] = num.law_code, grid.j1, grid.j2
-    # the linear law's dual and primal forms coincide; saturating laws need the dual
-    iprm[I_DUAL] = int(has_dual(num.law_code) and num.law_code != LINEAR)
-    return prm, iprm
-
-
-def scales(P: Params):
-    """Force, moment, displacement and rotation scales (Newton norms, rates)."""
-    eps = abs(P.e0) if P.e0 != 0.0 else 1e-6
-    force = P.B * eps
-    return np.array([force, force * 0.5 * P.h, eps * P.L, eps])
-
-
-__all__ = ["Numerics", "resolve", "build_grid", "pack", "scales", "LINEAR"]

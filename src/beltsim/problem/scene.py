@@ -14,7 +14,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from .errors import SceneError
+from ..errors import SceneError
+from ..physics.grid import MIN_ELEMENTS
 
 # ---------------------------------------------------------------------------
 # Schema
@@ -111,8 +112,8 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "rotary_inertia": POS,
     },
     "numerics": {
-        "integrator": _Rule("str", choices=("implicit", "explicit", "steady")),
-        "elements": _Rule("int", minimum=6),
+        "integrator": _Rule("str"),  # a registered scheme: checked in validate()
+        "elements": _Rule("int", minimum=MIN_ELEMENTS),
         "grading": _Rule("float", minimum=1.0),
         "dt": POS,
         "t_end": POS,
@@ -206,9 +207,11 @@ def validate(data: dict) -> dict:
             raise SceneError(f"{section}.{key}: only for physics.inertia = true "
                              f"(a quasistatic scene has no inertia terms)")
     integ = out.get("numerics", {}).get("integrator")
-    if integ == "explicit" and not inertia:
-        raise SceneError('numerics.integrator: "explicit" needs physics.inertia = true '
-                         '(a quasistatic scene has no dynamics to step explicitly)')
+    if integ is not None:
+        from .. import solvers  # the registry knows the schemes and what each needs
+        reason = solvers.applicable(integ, inertia)
+        if reason:
+            raise SceneError(reason)
 
     beam, contact = out["beam"], out["contact"]
     L, x1, x2 = beam["length"], contact["start"], contact["end"]
@@ -219,14 +222,12 @@ def validate(data: dict) -> dict:
         raise SceneError(f"contact.start/end: the contact must lie inside the beam, "
                          f"0 < start < end < beam.length = {L!r}, got [{x1!r}, {x2!r}]")
 
-    p = _stiffness(out)
-    if inertia:
-        c = out["motion"]["belt_speed"]
-        c_t, c_b = math.sqrt(p["b1"] / p["rho"]), math.sqrt(p["a"] / p["I"])
-        if p["rho"] * c * c >= p["b1"] or p["I"] * c * c >= p["a"]:
-            raise SceneError(
-                f"motion.belt_speed: must stay below both critical speeds, "
-                f"sqrt(b1/rho) = {c_t:.6g} m/s and sqrt(a/I) = {c_b:.6g} m/s, got {c!r} m/s")
+    P = _params(out)
+    if P.inertia and (P.rho * P.c**2 >= P.b1 or P.I * P.c**2 >= P.a):
+        c_t, c_b = P.critical_speeds
+        raise SceneError(
+            f"motion.belt_speed: must stay below both critical speeds, "
+            f"sqrt(b1/rho) = {c_t:.6g} m/s and sqrt(a/I) = {c_b:.6g} m/s, got {P.c!r} m/s")
     return out
 
 
@@ -302,6 +303,19 @@ class Params:
         return math.sqrt(self.b1 / self.rho), math.sqrt(self.a / self.I)
 
 
+def _params(d: dict) -> Params:
+    p = _stiffness(d)
+    contact = d["contact"]
+    return Params(
+        L=d["beam"]["length"], h=d["beam"]["height"],
+        x1=contact["start"], x2=contact["end"],
+        c=d["motion"]["belt_speed"], v=d["motion"]["surface_speed"],
+        a=p["a"], b1=p["b1"], b2=p["b2"], rho=p["rho"], I=p["I"],
+        inertia=d["physics"]["inertia"], friction=contact["friction"],
+        fstar=contact.get("max_friction"),
+    )
+
+
 # ---------------------------------------------------------------------------
 # Scene
 
@@ -351,25 +365,6 @@ class Scene:
             set_key(data, key, value)
         return Scene(data, source=self.source)
 
-    def replace(self, **kw) -> "Scene":
-        """Return a copy with ``section__key=value`` replaced (``None`` deletes the key)."""
-        data = self.to_dict()
-        for name, value in kw.items():
-            section, key = name.split("__")
-            if value is None:
-                data.get(section, {}).pop(key, None)
-            else:
-                data.setdefault(section, {})[key] = value
-        return Scene(data, source=self.source)
-
-    # accessors --------------------------------------------------------
-    def __getitem__(self, section):
-        return copy.deepcopy(self._data[section])
-
-    def get(self, dotted: str, default=None):
-        section, key = dotted.split(".", 1)
-        return self._data.get(section, {}).get(key, default)
-
     @property
     def title(self) -> str:
         return self._data.get("title", "")
@@ -380,17 +375,7 @@ class Scene:
 
     @property
     def params(self) -> Params:
-        d = self._data
-        p = _stiffness(d)
-        contact = d["contact"]
-        return Params(
-            L=d["beam"]["length"], h=d["beam"]["height"],
-            x1=contact["start"], x2=contact["end"],
-            c=d["motion"]["belt_speed"], v=d["motion"]["surface_speed"],
-            a=p["a"], b1=p["b1"], b2=p["b2"], rho=p["rho"], I=p["I"],
-            inertia=d["physics"]["inertia"], friction=contact["friction"],
-            fstar=contact.get("max_friction"),
-        )
+        return _params(self._data)
 
     def to_toml(self) -> str:
         """Serialise back to TOML (provenance file beside a run's outputs)."""

@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .analytic import AnalyticSolution
-from .friction import saturation
-from .grid import Grid
-from .scene import Params
+from ..physics.friction import saturation
+from ..physics.grid import Grid
+from ..problem.analytic import AnalyticSolution
+from ..problem.scene import Params
 
 
 def nodal_slope(values, he):
@@ -32,6 +32,26 @@ def nodal_slope(values, he):
     e = np.diff(values, axis=-1) / he
     return np.concatenate([e[..., :1], 0.5 * (e[..., 1:] + e[..., :-1]), e[..., -1:]],
                           axis=-1)
+
+
+def stress_resultants(P: Params, u, theta, he) -> dict:
+    """Tension b1 u_x and moment a theta_x at the nodes (works on stacks of states)."""
+    return {"tension": P.b1 * nodal_slope(u, he), "moment": P.a * nodal_slope(theta, he)}
+
+
+def traction(fnode, he):
+    """Element traction f (N/m) at each node (of the element upstream), 0 off contact.
+
+    Works on stacks of states (last axis: nodes).
+    """
+    f = np.zeros_like(fnode)
+    f[..., 1:] = fnode[..., 1:] / he
+    return f
+
+
+def relative_error(value, exact) -> float:
+    """|value - exact| / |exact|, or the absolute difference where exact is 0."""
+    return abs(value - exact) / abs(exact) if exact != 0 else abs(value - exact)
 
 
 LAYER, FIT = 3, 3  # elements of the discrete force layer at x2, and of the smooth fit
@@ -49,8 +69,8 @@ class DiscreteSolution:
         self.td = np.zeros_like(self.u) if td is None else np.asarray(td, dtype=float).copy()
         self.fnode = np.asarray(fnode, dtype=float).copy()
         self.model = "stick" if params.friction == "stick" else "slip"
-        self._law = law_code
-        self._fs = fs
+        self.law_code = law_code
+        self.fs = fs
 
     @property
     def x(self):
@@ -58,18 +78,14 @@ class DiscreteSolution:
 
     @property
     def traction(self) -> np.ndarray:
-        """Element traction f (N/m) at each node (of the element upstream), 0 off contact."""
-        f = np.zeros_like(self.fnode)
-        he = self.grid.he
-        f[1:] = self.fnode[1:] / he
-        return f
+        return traction(self.fnode, self.grid.he)
 
     def fields(self) -> dict:
         """Nodal fields with the analytic header: strain and moment averaged from elements."""
-        P, he = self.params, self.grid.he
-        strain, kappa = nodal_slope(self.u, he), nodal_slope(self.theta, he)
-        return {"u": self.u, "theta": self.theta, "strain": strain,
-                "tension": P.b1 * strain, "moment": P.a * kappa, "friction": self.traction}
+        he = self.grid.he
+        return {"u": self.u, "theta": self.theta, "strain": nodal_slope(self.u, he),
+                **stress_resultants(self.params, self.u, self.theta, he),
+                "friction": self.traction}
 
     # totals ---------------------------------------------------------
     @property
@@ -78,9 +94,9 @@ class DiscreteSolution:
 
     def _sliding(self):
         """Boolean per node: the element upstream of the node slides."""
-        g = np.abs(self.fnode[1:] / self.grid.he) / self._fs
+        g = np.abs(self.fnode[1:] / self.grid.he) / self.fs
         s = np.zeros_like(self.fnode, dtype=bool)
-        s[1:] = g >= saturation(self._law)
+        s[1:] = g >= saturation(self.law_code)
         s[: self.grid.j1 + 1] = False
         s[self.grid.j2 + 1:] = False
         return s
@@ -142,13 +158,11 @@ def compare(sim: DiscreteSolution, ref: AnalyticSolution) -> dict:
         diff = np.max(np.abs(getattr(sim, name) - a[name]))
         return float(diff / scale) if scale > 0 else float(diff)
 
-    def rel(x, y):
-        return abs(x - y) / abs(y) if y != 0 else abs(x - y)
-
-    out = {"total_friction": rel(sim.total_friction, ref.total_friction),
+    out = {"total_friction": relative_error(sim.total_friction, ref.total_friction),
            "u": rel_field("u"), "theta": rel_field("theta")}
     if ref.model == "stick":
-        out["concentrated_force"] = rel(sim.concentrated_force, ref.concentrated_force)
+        out["concentrated_force"] = relative_error(sim.concentrated_force,
+                                                   ref.concentrated_force)
         out["slip_start"] = None
     else:
         out["concentrated_force"] = None

@@ -24,56 +24,110 @@ the unknowns (u_j, theta_j); the Jacobian is block tridiagonal with 2x2 blocks.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from .friction import law, law_inverse, law_numpy
+from ..problem.drive import mismatch
+from .friction import LINEAR, has_dual, law, law_inverse, law_numpy
 
-# indices into the float parameter vector
-P_B, P_A, P_B2, P_RHO, P_I, P_C, P_HH, P_DAMP, P_FS, P_VREG, P_DV, P_TRAMP = range(12)
-N_PRM = 12
-# indices into the integer parameter vector
-I_LAW, I_J1, I_J2, I_DUAL = range(4)
-N_IPRM = 4
 # |lam| bound in the primal-dual iteration: the friction of a fully sliding node is
 # then f* (1 - 1e-14), and g^{-1} stays finite
 LAM_MAX = 1.0 - 1e-14
 
 
-@njit(cache=True)
-def ramp(t, t_ramp):
-    """Smooth (C2) ramp from 0 to 1 over [0, t_ramp]."""
-    if t_ramp <= 0.0 or t >= t_ramp:
-        return 1.0
-    if t <= 0.0:
-        return 0.0
-    s = t / t_ramp
-    return s * s * s * (10.0 - 15.0 * s + 6.0 * s * s)
+class ModelParams(NamedTuple):
+    """The coefficients of the discrete model, as the kernels read them."""
+
+    tension_eff: float  # B = b1 - rho c^2
+    bending_eff: float  # A = a - I c^2
+    shear: float  # b2
+    mass: float  # rho, per unit length (0 when quasistatic)
+    rotary_inertia: float  # I, per unit length (0 when quasistatic)
+    speed: float  # c
+    half_height: float  # h / 2: lever of the friction about the middle line
+    damping: float  # d (1/s) of d rho u_t and d I theta_t
+    friction_scale: float  # f_s in f = -f_s g(v_rel / v_reg)
+    v_reg: float  # regularisation velocity
+    law: int  # friction law code (friction.LAW_CODES)
+    dual: int  # 1: the friction ratio is a Newton unknown (primal-dual form)
+
+
+class Mesh(NamedTuple):
+    """The grid as the kernels read it."""
+
+    he: np.ndarray  # element lengths (N)
+    hb: np.ndarray  # nodal control-volume lengths (N + 1)
+    j1: int  # node at x1
+    j2: int  # node at x2
+
+
+class State(NamedTuple):
+    """The discrete state: nodal fields, their local rates, and the friction unknowns.
+
+    ``lam`` holds, at contact nodes, the friction ratio g(v_rel / v_reg) (Newton
+    schemes) or the argument v_rel / v_reg itself (the explicit scheme's warm start);
+    ``fnode`` the nodal friction forces of the state (N).
+    """
+
+    u: np.ndarray
+    theta: np.ndarray
+    lam: np.ndarray
+    ud: np.ndarray
+    td: np.ndarray
+    fnode: np.ndarray
+
+    @classmethod
+    def zeros(cls, n_nodes: int) -> "State":
+        return cls(*(np.zeros(n_nodes) for _ in cls._fields))
+
+    def copy(self) -> "State":
+        return State(*(a.copy() for a in self))
+
+    def assign(self, other) -> None:
+        for a, b in zip(self, other):
+            a[:] = b
+
+
+def model_params(P, damping, friction_scale, v_reg, law_code) -> ModelParams:
+    """The model's coefficients from the physical parameters and the friction settings."""
+    # the linear law's dual and primal forms coincide; saturating laws need the dual
+    dual = int(has_dual(law_code) and law_code != LINEAR)
+    return ModelParams(
+        tension_eff=P.B, bending_eff=P.A, shear=P.b2, mass=P.rho, rotary_inertia=P.I,
+        speed=P.c, half_height=0.5 * P.h, damping=damping, friction_scale=friction_scale,
+        v_reg=v_reg, law=law_code, dual=dual)
+
+
+def mesh_of(grid) -> Mesh:
+    return Mesh(grid.he, grid.hbar, grid.j1, grid.j2)
 
 
 @njit(cache=True)
-def assemble(u, th, lam, uo, tho, udo, tdo, inv_dt, t, he, hb, prm, iprm, R, Lb, Db, Ub,
-             fnode, rl, sg, want_jac):
-    """Residual R (n, 2) of the interior nodes and, if want_jac, the Jacobian blocks.
+def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, w, want_jac):
+    """Residual w.R (n, 2) of the interior nodes and, if want_jac, the Jacobian blocks.
 
-    u, th: trial values at t (N+1, boundary zeros); uo, tho, udo, tdo: values and
-    local velocities at the previous step. fnode receives the nodal friction
-    forces (N) of the trial state.
+    u, th, lam: trial values at t (N+1, boundary zeros); old: the State at the
+    previous step (its values and local velocities). fnode receives the nodal
+    friction forces (N) of the trial state.
 
     Friction ratio lam = g(v_rel / v_reg) at each contact node: in the primal
-    form (iprm[I_DUAL] = 0) it is computed from the trial state; in the
-    primal-dual form it is an unknown with the equation
-    rl = v_rel / v_reg - g^{-1}(lam) = 0, condensed node by node into the
-    (u, theta) rows so the Jacobian stays block tridiagonal. sg receives the
-    slope dlam/d(v_rel / v_reg) used by :func:`update_multipliers`.
+    form (p.dual = 0) it is computed from the trial state; in the primal-dual form
+    it is an unknown with the equation rl = v_rel / v_reg - g^{-1}(lam) = 0,
+    condensed node by node into the (u, theta) rows so the Jacobian stays block
+    tridiagonal. w.sg receives the slope dlam/d(v_rel / v_reg) used by
+    :func:`update_multipliers`.
     """
     N = u.shape[0] - 1
-    B, A, b2 = prm[P_B], prm[P_A], prm[P_B2]
-    rho, I, c, hh = prm[P_RHO], prm[P_I], prm[P_C], prm[P_HH]
-    damp, fs, vreg = prm[P_DAMP], prm[P_FS], prm[P_VREG]
-    target = prm[P_DV] * ramp(t, prm[P_TRAMP])
-    code, j1, j2, dual = iprm[I_LAW], iprm[I_J1], iprm[I_J2], iprm[I_DUAL]
+    B, A, b2 = p.tension_eff, p.bending_eff, p.shear
+    rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
+    damp, fs, vreg = p.damping, p.friction_scale, p.v_reg
+    he, hb, j1, j2 = mesh.he, mesh.hb, mesh.j1, mesh.j2
+    uo, tho, udo, tdo = old.u, old.theta, old.ud, old.td
+    R, Lb, Db, Ub, rl, sg = w.R, w.Lb, w.Db, w.Ub, w.rl, w.sg
+    target = mismatch(drive, t)
+    code, dual = p.law, p.dual
     kin = inv_dt * inv_dt + damp * inv_dt  # d(acc + damp * vel)/dy
     for j in range(N + 1):
         fnode[j] = 0.0
@@ -137,17 +191,17 @@ def assemble(u, th, lam, uo, tho, udo, tdo, inv_dt, t, he, hb, prm, iprm, R, Lb,
 
 
 @njit(cache=True)
-def update_multipliers(lam, dx, inv_dt, he, prm, iprm, rl, sg):
+def update_multipliers(lam, dx, inv_dt, mesh, p, w):
     """Newton update of the friction ratios after the condensed solve.
 
     Each lam moves at most 99% of the way to the boundary of (-1, 1) (fraction to
     the boundary) and stays within LAM_MAX of it, so g^{-1}(lam) stays finite.
     Returns the largest change.
     """
-    c, hh, vreg = prm[P_C], prm[P_HH], prm[P_VREG]
-    j1, j2 = iprm[I_J1], iprm[I_J2]
+    c, hh, vreg = p.speed, p.half_height, p.v_reg
+    he, rl, sg = mesh.he, w.rl, w.sg
     big = 0.0
-    for j in range(j1 + 1, j2 + 1):
+    for j in range(mesh.j1 + 1, mesh.j2 + 1):
         hl = he[j - 1]
         dub = dx[j - 1, 0] + hh * dx[j - 1, 1]
         dub_l = dx[j - 2, 0] + hh * dx[j - 2, 1] if j >= 2 else 0.0
@@ -209,10 +263,10 @@ def block_solve(Lb, Db, Ub, r, x, C):
 
 
 # ---------------------------------------------------------------------------
-# numpy twins (tests and post-processing)
+# numpy twins (tests, the bench's peer)
 
 
-def forces_numpy(u, th, ud, td, t, he, hb, prm, iprm):
+def forces_numpy(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive):
     """Nodal forces and moments of the semi-discrete model, all but the inertia terms.
 
     Returns (force on u, moment on theta) at the interior nodes and the nodal
@@ -220,35 +274,30 @@ def forces_numpy(u, th, ud, td, t, he, hb, prm, iprm):
     m u_tt = force, m_I theta_tt = moment. Vectorised twin of :func:`assemble`, and
     the right-hand side of the method-of-lines system (the bench's peer).
     """
-    B, A, b2 = prm[P_B], prm[P_A], prm[P_B2]
-    rho, I, c, hh = prm[P_RHO], prm[P_I], prm[P_C], prm[P_HH]
-    damp, fs, vreg = prm[P_DAMP], prm[P_FS], prm[P_VREG]
-    tr = prm[P_TRAMP]
-    s = 1.0 if (tr <= 0 or t >= tr) else (0.0 if t <= 0 else (t / tr) ** 3 * (
-        10 - 15 * (t / tr) + 6 * (t / tr) ** 2))
-    code, j1, j2 = int(iprm[I_LAW]), int(iprm[I_J1]), int(iprm[I_J2])
+    B, A, b2 = p.tension_eff, p.bending_eff, p.shear
+    rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
+    he, hb = mesh.he, mesh.hb
     ub = u + hh * th
     F = np.zeros_like(u)
-    j = np.arange(j1 + 1, j2 + 1)
-    vrel = ud[j] + hh * td[j] + c * (ub[j] - ub[j - 1]) / he[j - 1] - prm[P_DV] * s
-    F[j] = -he[j - 1] * fs * law_numpy(code, vrel / vreg)[0]
+    j = np.arange(mesh.j1 + 1, mesh.j2 + 1)
+    vrel = ud[j] + hh * td[j] + c * (ub[j] - ub[j - 1]) / he[j - 1] - mismatch(drive, t)
+    F[j] = -he[j - 1] * p.friction_scale * law_numpy(p.law, vrel / p.v_reg)[0]
     sl = slice(1, -1)
     fu = (B * np.diff(np.diff(u) / he) - rho * c * (ud[2:] - ud[:-2])
-          - damp * rho * hb[sl] * ud[sl] + F[sl])
+          - p.damping * rho * hb[sl] * ud[sl] + F[sl])
     ft = (A * np.diff(np.diff(th) / he) - b2 * hb[sl] * th[sl] - I * c * (td[2:] - td[:-2])
-          - damp * I * hb[sl] * td[sl] + hh * F[sl])
+          - p.damping * I * hb[sl] * td[sl] + hh * F[sl])
     return fu, ft, F
 
 
-def residual_numpy(u, th, uo, tho, udo, tdo, inv_dt, t, he, hb, prm, iprm):
+def residual_numpy(u, th, old: State, inv_dt, t, mesh: Mesh, p: ModelParams, drive):
     """Vectorised twin of :func:`assemble` (residual and nodal friction only)."""
-    rho, I = prm[P_RHO], prm[P_I]
-    ud = (u - uo) * inv_dt
-    td = (th - tho) * inv_dt
-    fu, ft, F = forces_numpy(u, th, ud, td, t, he, hb, prm, iprm)
-    sl = slice(1, -1)
-    ru = rho * hb[sl] * (ud[sl] - udo[sl]) * inv_dt - fu
-    rt = I * hb[sl] * (td[sl] - tdo[sl]) * inv_dt - ft
+    ud = (u - old.u) * inv_dt
+    td = (th - old.theta) * inv_dt
+    fu, ft, F = forces_numpy(u, th, ud, td, t, mesh, p, drive)
+    sl, hb = slice(1, -1), mesh.hb
+    ru = p.mass * hb[sl] * (ud[sl] - old.ud[sl]) * inv_dt - fu
+    rt = p.rotary_inertia * hb[sl] * (td[sl] - old.td[sl]) * inv_dt - ft
     return np.column_stack([ru, rt]), F
 
 

@@ -1,0 +1,112 @@
+"""A run's outputs: summary.json, fields.csv, history.csv, scene.toml, snapshots, checkpoints.
+
+All written atomically (:mod:`beltsim.io.files`); ``summary.json`` last, so its
+presence means the run's outputs are complete.
+"""
+
+from __future__ import annotations
+
+import io
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SceneError
+from ..problem.scene import Scene
+from .files import OutputError, prepare_outdir, write_atomic, write_csv, write_json
+
+FIELDS_HEADER = ("x", "u", "theta", "strain", "tension", "moment", "friction")
+SNAPSHOTS = "snapshots.npz"
+CHECKPOINT = "checkpoint.npz"
+
+
+def write_fields(path, x, fields: dict) -> Path:
+    return write_csv(path, FIELDS_HEADER, [x] + [fields[k] for k in FIELDS_HEADER[1:]])
+
+
+def save_run(result, out) -> list[Path]:
+    """Write a run's summary.json, fields.csv, history.csv and scene.toml into ``out``.
+
+    A failed run writes its summary (converged = false, the reason) and the
+    fields of the last good state, which hold no NaN by construction.
+    """
+    out = prepare_outdir(out)
+    sol = result.solution
+    keys = tuple(result.history)
+    paths = [
+        write_fields(out / "fields.csv", sol.x, sol.fields()),
+        write_csv(out / "history.csv", keys, [result.history[k] for k in keys]),
+        write_atomic(out / "scene.toml", result.scene.to_toml()),
+    ]
+    if result.snapshots:
+        paths.append(write_snapshots(out / SNAPSHOTS, result))
+    # the summary last: its presence means the other files are complete
+    paths.append(write_json(out / "summary.json", result.summary()))
+    return paths
+
+
+def write_snapshots(path, result) -> Path:
+    """States at every snapshot interval, compressed, in single precision.
+
+    Arrays: ``x`` (nodes), ``t`` (times), ``u``, ``theta``, ``friction`` (element
+    traction in N/m at the downstream node, as in fields.csv), each (times, nodes);
+    ``scene`` (the scene as TOML text). Single precision keeps a long run's file small
+    and is far finer than a plot.
+    """
+    from ..simulation.solution import traction
+
+    sol, snaps = result.solution, result.snapshots
+    buf = io.BytesIO()
+    np.savez_compressed(buf, x=sol.x, t=snaps["t"], u=snaps["u"].astype(np.float32),
+                        theta=snaps["theta"].astype(np.float32),
+                        friction=traction(snaps["fnode"], sol.grid.he).astype(np.float32),
+                        scene=np.array(result.scene.to_toml()))
+    return write_atomic(path, buf.getvalue())
+
+
+def read_snapshots(path) -> dict:
+    """The arrays of :func:`write_snapshots`, with ``scene`` as a Scene."""
+    try:
+        with np.load(path) as z:
+            data = {k: z[k] for k in ("x", "t", "u", "theta", "friction")}
+            data["scene"] = Scene(tomllib.loads(str(z["scene"])))
+    except (OSError, KeyError, ValueError) as exc:
+        raise OutputError(f"{path}: not a beltsim snapshots file ({exc})") from None
+    return data
+
+
+def write_checkpoint(path, sim) -> Path:
+    """Everything a resumed run needs to continue exactly as this one would.
+
+    The state, the time, the scheme's own state (step size, counters) and the state
+    of every tracker that carries one, each under a prefix of its own.
+    """
+    data = {f"state.{k}": a for k, a in zip(sim.state._fields, sim.state)}
+    data.update({f"scheme.{k}": v for k, v in sim.scheme.checkpoint().items()})
+    for name, items in sim.tracker_states().items():
+        data.update({f"tracker.{name}.{k}": v for k, v in items.items()})
+    data["t"], data["wall_time"] = np.array(sim.t), np.array(sim.wall_time)
+    data["scene"] = np.array(sim.scene.to_toml())
+    buf = io.BytesIO()
+    np.savez(buf, **data)
+    return write_atomic(path, buf.getvalue())
+
+
+def read_checkpoint(path) -> dict:
+    """The parts of :func:`write_checkpoint`: scene, t, wall_time, state, scheme, trackers."""
+    try:
+        with np.load(path) as z:
+            scene = Scene(tomllib.loads(str(z["scene"])))
+            out = {"scene": scene, "t": float(z["t"]), "wall_time": float(z["wall_time"]),
+                   "state": {}, "scheme": {}, "trackers": {}}
+            for key in z.files:
+                part, _, rest = key.partition(".")
+                if part in ("state", "scheme"):
+                    out[part][rest] = z[key]
+                elif part == "tracker":
+                    name, _, k = rest.partition(".")
+                    out["trackers"].setdefault(name, {})[k] = z[key]
+    except (OSError, ValueError, KeyError, tomllib.TOMLDecodeError) as exc:
+        raise SceneError(f"--resume: cannot read checkpoint {path} ({exc})") from None
+    return out

@@ -1,0 +1,1 @@
+"""The discrete model: friction laws, the Eulerian grid, residual and Jacobian kernels."""

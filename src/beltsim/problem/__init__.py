@@ -1,0 +1,1 @@
+"""The problem: scene files, physical parameters, the drive, exact steady solutions."""

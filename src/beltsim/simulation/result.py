@@ -1,0 +1,77 @@
+"""The outcome of a run: its status, its final state read as a solution, its records."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+from ..problem import analytic
+from ..problem.scene import Scene
+from ..solvers.settings import Numerics
+from .solution import DiscreteSolution, compare
+
+
+class RunStatus(enum.Enum):
+    CONVERGED = "converged"  # steady state reached
+    REACHED_END = "reached t_end"  # t_end reached before steady state
+    FAILED = "failed"  # stopped on a numerical failure; the state is the last good one
+    INTERRUPTED = "interrupted"  # a signal or a callback asked it to stop
+
+
+@dataclass
+class RunResult:
+    scene: Scene
+    numerics: Numerics
+    status: RunStatus
+    reason: str | None
+    solution: DiscreteSolution
+    simulated_time: float
+    wall_time: float
+    compile_time: float
+    statistics: dict
+    history: dict
+    snapshots: dict = field(default_factory=dict)
+    #: the exact steady solution of the same scene, attached by the caller (None: not
+    #: attached, or the scene has none)
+    reference: analytic.AnalyticSolution | None = None
+
+    @property
+    def converged(self) -> bool:
+        return self.status is RunStatus.CONVERGED
+
+    @property
+    def failed(self) -> bool:
+        return self.status is RunStatus.FAILED
+
+    @property
+    def interrupted(self) -> bool:
+        return self.status is RunStatus.INTERRUPTED
+
+    @property
+    def steps(self) -> int:
+        return self.statistics["steps"]
+
+    @property
+    def newton_iterations(self) -> int:
+        return self.statistics.get("newton_iterations", 0)
+
+    def errors(self) -> dict | None:
+        if self.reference is None:
+            return None
+        return compare(self.solution, self.reference)
+
+    def summary(self) -> dict:
+        out = self.solution.summary()
+        out.update(converged=self.converged, simulated_time=self.simulated_time,
+                   steps=self.steps, wall_time=self.wall_time, compile_time=self.compile_time,
+                   reason=self.reason, elements=self.numerics.elements,
+                   integrator=self.numerics.integrator, error=self.errors())
+        return out
+
+
+def reference_of(scene: Scene, model: str | None = None):
+    """The exact steady solution of a scene, or None where it has none."""
+    try:
+        return analytic.solve(scene, model=model)
+    except analytic.NoSolutionError:
+        return None

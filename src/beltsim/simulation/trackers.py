@@ -1,0 +1,281 @@
+"""Trackers: what the controller does between two chunks of simulated time.
+
+As in py-pde's TrackerCollection, each tracker has ``initialize(sim)``,
+``handle(sim)`` (after every chunk; it may return a :class:`Stop`) and
+``finalize(sim, status)``. Trackers that a resumed run needs carry a
+``state()``/``restore()`` pair, stored in the checkpoint under their ``name``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import NumericalError
+from .result import RunStatus
+
+GROWTH_LIMIT = 1e4  # |u| / (|e0| L) or |theta| / |e0| beyond this counts as divergence
+
+
+@dataclass(frozen=True)
+class Stop:
+    """A tracker's request to end the run."""
+
+    status: RunStatus
+    reason: str | None = None
+
+
+class Tracker:
+    name = ""
+
+    def initialize(self, sim) -> None:
+        pass
+
+    def handle(self, sim) -> Stop | None:
+        return None
+
+    def finalize(self, sim, status: RunStatus) -> None:
+        pass
+
+    def state(self) -> dict:
+        return {}
+
+    def restore(self, data: dict) -> None:
+        pass
+
+
+class DivergenceGuard(Tracker):
+    """Non-finite values or growth beyond GROWTH_LIMIT times the scales: a numerical failure."""
+
+    def handle(self, sim):
+        s = sim.disc.scales
+        u, th = sim.state.u, sim.state.theta
+        if not (np.all(np.isfinite(u)) and np.all(np.isfinite(th))):
+            raise NumericalError(f"non-finite displacement or rotation at t = {sim.t:.6g} s",
+                                 t=sim.t, quantity="u/theta")
+        gu = np.max(np.abs(u)) / s.u
+        gt = np.max(np.abs(th)) / s.theta
+        if gu > GROWTH_LIMIT or gt > GROWTH_LIMIT:
+            q, g = ("u", gu) if gu >= gt else ("theta", gt)
+            raise NumericalError(
+                f"{q} grew without bound at t = {sim.t:.6g} s ({g:.3g} times its scale)",
+                t=sim.t, quantity=q)
+        return None
+
+
+class HistoryTracker(Tracker):
+    """t, total friction and the largest local rate at every check."""
+
+    name = "history"
+    KEYS = ("t", "total_friction", "rate")
+
+    def __init__(self):
+        self.data = {k: [] for k in self.KEYS}
+
+    def handle(self, sim):
+        self.data["t"].append(sim.t)
+        self.data["total_friction"].append(sim.total_friction())
+        self.data["rate"].append(sim.rate())
+        return None
+
+    def arrays(self) -> dict:
+        return {k: np.array(v) for k, v in self.data.items()}
+
+    def state(self):
+        return {"rows": np.array([self.data[k] for k in self.KEYS])}
+
+    def restore(self, data):
+        for k, row in zip(self.KEYS, data["rows"]):
+            self.data[k] = list(row)
+
+
+class SteadyStateTracker(Tracker):
+    """Steady when, ``hold`` checks in a row after the ramp, both the largest local rate
+    (max |u_t| and L max |theta_t|, relative to c |e0|) and the change of the total
+    friction over one window of simulated time (relative to its value) are below ``tol``.
+    """
+
+    name = "steady"
+
+    def __init__(self, tol: float, window: float, t_min: float, friction_scale: float,
+                 hold: int = 3):
+        self.tol, self.window, self.t_min, self.hold = tol, window, t_min, hold
+        self.friction_scale = friction_scale
+        self._hist: deque = deque()
+        self._count = 0
+        self.change = math.inf
+        self.rate = math.inf
+
+    def update(self, t: float, rate: float, total_friction: float) -> bool:
+        """Record a check; True once the state has been steady ``hold`` times in a row."""
+        self.rate = rate
+        self._hist.append((t, total_friction))
+        while len(self._hist) > 1 and self._hist[1][0] <= t - self.window:
+            self._hist.popleft()
+        t0, f0 = self._hist[0]
+        if t - t0 >= self.window * (1 - 1e-9):
+            denom = max(abs(total_friction), self.friction_scale)
+            self.change = abs(total_friction - f0) / denom
+        else:
+            self.change = math.inf
+        if t >= self.t_min and rate < self.tol and self.change < self.tol:
+            self._count += 1
+        else:
+            self._count = 0
+        return self._count >= self.hold
+
+    def handle(self, sim):
+        if self.update(sim.t, sim.rate(), sim.total_friction()):
+            return Stop(RunStatus.CONVERGED)
+        return None
+
+    def not_steady(self, t_end: float) -> str:
+        return (f"not steady by t_end = {t_end:.6g} s (rate {self.rate:.3g}, friction change "
+                f"{self.change:.3g} per window; tolerance {self.tol:.3g})")
+
+    def state(self):
+        return {"scalars": np.array([self._count, self.change, self.rate]),
+                "window": np.array(list(self._hist)).reshape(-1, 2)}
+
+    def restore(self, data):
+        count, self.change, self.rate = data["scalars"]
+        self._count = int(count)
+        self._hist = deque(map(tuple, data["window"]))
+
+
+class SnapshotTracker(Tracker):
+    """The state at (about) every ``interval`` of simulated time, and at the end."""
+
+    name = "snapshots"
+    KEYS = ("u", "theta", "fnode")
+
+    def __init__(self, interval: float):
+        self.interval = interval
+        self.times: list = []
+        self.fields: dict = {k: [] for k in self.KEYS}
+
+    def take(self, sim):
+        self.times.append(sim.t)
+        self.fields["u"].append(sim.state.u.copy())
+        self.fields["theta"].append(sim.state.theta.copy())
+        self.fields["fnode"].append(sim.state.fnode.copy())
+
+    def initialize(self, sim):
+        if not self.times:
+            self.take(sim)
+
+    def handle(self, sim):
+        if sim.t >= self.times[-1] + self.interval * (1 - 1e-9):
+            self.take(sim)
+        return None
+
+    def finalize(self, sim, status):
+        if status is not RunStatus.INTERRUPTED and self.times[-1] < sim.t:
+            self.take(sim)
+
+    def arrays(self) -> dict:
+        return {"t": np.array(self.times), **{k: np.array(v) for k, v in self.fields.items()}}
+
+    def state(self):
+        return {"interval": np.array(self.interval), **self.arrays()}
+
+    def restore(self, data):
+        self.times = list(data["t"])
+        for k in self.KEYS:
+            self.fields[k] = list(data[k])
+
+
+class ProgressTracker(Tracker):
+    """A tqdm bar on a terminal: simulated time, rate and total friction."""
+
+    def __init__(self):
+        self.bar = None
+
+    def initialize(self, sim):
+        import sys
+
+        from tqdm import tqdm
+        if not sys.stderr.isatty():
+            return
+        self.bar = tqdm(total=sim.numerics.t_end, initial=sim.t, unit="s", unit_scale=True,
+                        desc="simulated", leave=False,
+                        bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s "
+                                   "[{elapsed}<{remaining}]{postfix}")
+
+    def handle(self, sim):
+        if self.bar is not None:
+            self.bar.update(min(sim.t, sim.numerics.t_end) - self.bar.n)
+            self.bar.set_postfix(rate=f"{sim.rate():.2e}", friction=f"{sim.total_friction():.5g}",
+                                 refresh=False)
+        return None
+
+    def finalize(self, sim, status):
+        if self.bar is not None:
+            self.bar.close()
+
+
+class CallbackTracker(Tracker):
+    """``callback(sim)`` after every chunk; a true return value stops the run."""
+
+    def __init__(self, callback):
+        self.callback = callback
+
+    def handle(self, sim):
+        if self.callback(sim):
+            return Stop(RunStatus.INTERRUPTED, f"interrupted (callback) at t = {sim.t:.6g} s")
+        return None
+
+
+class SignalTracker(Tracker):
+    """SIGINT and SIGTERM set a flag that ends the run at the next check.
+
+    A KeyboardInterrupt raised while a kernel returns could leave the time and the
+    state out of step; a flag read at a chunk boundary cannot.
+    """
+
+    def __init__(self):
+        self.requested = None
+        self._old = {}
+
+    def initialize(self, sim):
+        import signal
+        import threading
+        if threading.current_thread() is not threading.main_thread():
+            return
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            self._old[sig] = signal.signal(sig, self._handler)
+
+    def _handler(self, signum, frame):
+        import signal
+        self.requested = signal.Signals(signum).name
+
+    def handle(self, sim):
+        if self.requested:
+            return Stop(RunStatus.INTERRUPTED,
+                        f"interrupted ({self.requested}) at t = {sim.t:.6g} s")
+        return None
+
+    def finalize(self, sim, status):
+        import signal
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+        self._old = {}
+
+
+class CheckpointTracker(Tracker):
+    """At the end: a checkpoint when the run was interrupted or failed, none otherwise."""
+
+    def __init__(self, path):
+        self.path = path
+
+    def finalize(self, sim, status):
+        from pathlib import Path
+
+        from ..io.results import write_checkpoint
+        if status in (RunStatus.INTERRUPTED, RunStatus.FAILED):
+            write_checkpoint(self.path, sim)
+        else:
+            Path(self.path).unlink(missing_ok=True)

@@ -1,0 +1,9 @@
+"""Solvers: numerical settings, the registry of schemes, one module per scheme.
+
+Importing this package registers every scheme (see :mod:`beltsim.solvers.base`).
+"""
+
+from . import explicit, implicit, steady  # noqa: F401  (each registers its scheme)
+from .base import Discretisation, Scheme, applicable, get, names, register
+
+__all__ = ["Discretisation", "Scheme", "applicable", "get", "names", "register"]

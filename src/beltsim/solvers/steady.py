@@ -1,0 +1,63 @@
+"""Steady scheme: Newton on the discrete equations with d/dt = 0, from rest.
+
+The surface speed goes from c to v in stages of continuation (the mismatch
+v - c scaled by s in (0, 1]): a stage that converges doubles the next one, a
+failed stage is undone and retried with a quarter of its size. It lands on the
+same discrete steady state as the transient schemes.
+"""
+
+from __future__ import annotations
+
+from ..errors import NumericalError
+from ..problem.drive import Drive
+from .base import register
+from .implicit import NewtonScheme
+from .newton import NewtonSettings, newton
+
+MIN_STAGE = 1e-6  # smallest continuation stage, relative to the full mismatch
+STAGE_ITERATIONS = 4  # Newton iterations per stage, in units of newton_max_iterations
+
+
+@register
+class SteadyScheme(NewtonScheme):
+    name = "steady"
+    transient = False
+
+    def __init__(self, disc):
+        super().__init__(disc)
+        self.old = disc.new_state()  # inv_dt = 0: the previous step does not enter
+        num = self.numerics
+        self.stage_settings = NewtonSettings(num.newton_tol, STAGE_ITERATIONS * num.newton_max_it)
+
+    def _stage(self, state, s, settings):
+        d = self.disc
+        drive = Drive(d.drive.mismatch * s, 0.0)
+        return newton(state, self.old, 0.0, 0.0, d.mesh, d.model, drive, d.scales, settings,
+                      self.work)
+
+    def _compile(self, state) -> None:
+        trial = state.copy()
+        self._stage(trial, 0.0, NewtonSettings(1.0, 0))
+        self.work.stats[:] = 0
+
+    def solve(self, state) -> None:
+        """Continuation in v - c; the number of stages is counted as steps.
+
+        Raises NumericalError when the stage falls below MIN_STAGE of the mismatch.
+        """
+        s_done, ds = 0.0, 1.0
+        while s_done < 1.0:
+            s = min(1.0, s_done + ds)
+            saved = state.copy()
+            ok = self._stage(state, s, self.stage_settings)
+            self.steps += 1
+            if ok:
+                s_done, ds = s, 2.0 * ds
+            else:
+                state.assign(saved)
+                ds *= 0.25
+                if ds < MIN_STAGE:
+                    raise NumericalError(
+                        f"steady Newton iteration failed at {100 * s_done:.4g}% of the "
+                        f"speed mismatch (continuation step below {MIN_STAGE:g})", t=0.0,
+                        quantity="newton")

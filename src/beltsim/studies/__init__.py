@@ -1,0 +1,1 @@
+"""Studies that measure the schemes: convergence, bench, stability, sweeps, the paper."""

@@ -1,0 +1,138 @@
+"""The stability matrix: stiff and extreme scenes, each by every registered scheme.
+
+Each cell ends in one status, decided from structured outcomes: not applicable (the
+registry says the scheme does not apply to the scene), refused (the scene or its
+numerics break a rule before anything runs), or the status of the run (converged
+within the bounds of the transient simulator, out of bounds, not converged, diverged).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+
+from .. import solvers
+from ..errors import BeltsimError
+from ..problem.scene import load_scene, runs_dir
+from ..simulation.controller import Simulation
+from ..simulation.result import RunStatus, reference_of
+from .convergence import ERROR_KEYS
+
+#: The acceptance bounds of the transient simulator (relative errors; slip start in m).
+BOUNDS = {"total_friction": 5e-3, "u": 2e-2, "theta": 2e-2, "concentrated_force": 5e-2,
+          "slip_start": 5e-3}
+
+
+class CellStatus(str, enum.Enum):
+    CONVERGED = "converged"
+    OUT_OF_BOUNDS = "out of bounds"
+    NOT_CONVERGED = "not converged"
+    DIVERGED = "diverged"
+    REFUSED = "refused"
+    NOT_APPLICABLE = "not applicable"
+
+
+#: Statuses that count as a pass: the scheme either delivers or says why it cannot.
+ACCEPTED = (CellStatus.CONVERGED, CellStatus.REFUSED, CellStatus.NOT_APPLICABLE)
+_RUN_STATUS = {RunStatus.FAILED: CellStatus.DIVERGED, RunStatus.REACHED_END:
+               CellStatus.NOT_CONVERGED, RunStatus.INTERRUPTED: CellStatus.NOT_CONVERGED}
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    base: str  # a scene of runs/
+    overrides: tuple[str, ...] = ()
+
+    @property
+    def sets_grid(self) -> bool:
+        """Whether the case is about the grid itself (a coarse matrix leaves it out)."""
+        return any(o.startswith("numerics.elements=") for o in self.overrides)
+
+
+_THIN = ("beam.height=0.01",)
+#: Each derived from the paper's data.
+STABILITY_CASES = (
+    Case("paper quasistatic", "paper_quasistatic"),
+    Case("paper inertia", "paper_inertia"),
+    Case("paper slip", "paper_slip"),
+    Case("stiff friction (v_reg 1e-5, f* 1e8)", "paper_slip",
+         ("contact.max_friction=1e8", "numerics.regularisation=1e-5")),
+    Case("stiff belt (E x 100)", "paper_slip", ("beam.youngs_modulus=5e9",)),
+    Case("thin belt (h = 0.01 m)", "paper_slip", _THIN),
+    Case("thin belt, quasistatic", "paper_slip", _THIN + ("physics.inertia=false",)),
+    Case("near-critical (c = 0.97 sqrt(a/I))", "paper_slip",
+         ("motion.belt_speed=125.2265", "motion.surface_speed=126.4787")),
+    Case("large mismatch (v/c - 1 = 0.05)", "paper_slip", ("motion.surface_speed=126",)),
+    Case("v = c (zero state)", "paper_slip", ("motion.surface_speed=120",)),
+    Case("v < c (reversed forces)", "paper_slip", ("motion.surface_speed=118.8",)),
+    Case("short contact (x2 - x1 = 0.02 L)", "paper_slip",
+         ("contact.start=0.49", "contact.end=0.51")),
+    Case("contact ends 0.02 L from the outlet", "paper_slip",
+         ("contact.start=0.6466666666666666", "contact.end=0.98")),
+    Case("very fine grid (20,000 elements)", "paper_slip", ("numerics.elements=20000",)),
+)
+
+
+def stability_cell(case: Case, scheme: str, extra=()) -> dict:
+    """One cell: status, reason, dt, steps, wall time and errors of one scheme on one case."""
+    cell = {"scheme": scheme, "status": "", "reason": "", "dt": float("nan"), "steps": 0,
+            "wall_time": float("nan"), **{f"error_{k}": float("nan") for k in ERROR_KEYS}}
+    try:
+        scene = load_scene(runs_dir() / f"{case.base}.toml", [*case.overrides, *extra])
+    except BeltsimError as exc:
+        cell.update(status=CellStatus.REFUSED, reason=str(exc))
+        return cell
+    why_not = solvers.applicable(scheme, scene.params.inertia)
+    if why_not:
+        cell.update(status=CellStatus.NOT_APPLICABLE, reason=why_not)
+        return cell
+    try:
+        sim = Simulation(scene.with_overrides([f"numerics.integrator={scheme}"]))
+    except BeltsimError as exc:
+        cell.update(status=CellStatus.REFUSED, reason=str(exc))
+        return cell
+    res = sim.run(raise_on_failure=False)
+    res.reference = reference_of(scene)
+    err = res.errors() or {}
+    cell.update(dt=sim.numerics.dt if sim.scheme.transient else float("nan"),
+                steps=res.steps, wall_time=res.wall_time,
+                **{f"error_{k}": err[k] for k in ERROR_KEYS if err.get(k) is not None})
+    if not res.converged:
+        cell.update(status=_RUN_STATUS[res.status], reason=res.reason)
+    else:
+        over = [f"{k} {err[k]:.3g} > {b:g}" for k, b in BOUNDS.items()
+                if err.get(k) is not None and not err[k] <= b]
+        cell.update(status=CellStatus.OUT_OF_BOUNDS if over else CellStatus.CONVERGED,
+                    reason="; ".join(over))
+    return cell
+
+
+def stability_matrix(cases=STABILITY_CASES, schemes=None, extra=(), progress=None):
+    """Every case by every scheme (default: all registered), one row per cell."""
+    rows = []
+    for case in cases:
+        for scheme in schemes or solvers.names():
+            row = {"case": case.name, **stability_cell(case, scheme, extra=extra)}
+            rows.append(row)
+            if progress:
+                progress(row)
+    return rows
+
+
+def stability_markdown(rows) -> str:
+    """A table per case and scheme: status, dt, steps, wall time, errors, reason."""
+    head = ("| case | scheme | status | dt [s] | steps | wall [s] | total friction | u | theta "
+            "| conc. force | slip start [m] | reason |")
+    lines = [head, "|" + "---|" * 12]
+
+    def num(v, fmt):
+        return "" if v is None or (isinstance(v, float) and not math.isfinite(v)) else fmt % v
+    for r in rows:
+        lines.append("| " + " | ".join([
+            r["case"], r["scheme"], r["status"].value, num(r["dt"], "%.2e"), str(r["steps"]),
+            num(r["wall_time"], "%.3g"),
+            *(num(r[f"error_{k}"], "%.1e") for k in ERROR_KEYS),
+            r["reason"].replace("|", "/")]) + " |")
+    return "\n".join(lines) + "\n"
