@@ -1,30 +1,24 @@
 """Animated transients from a run's snapshot file."""
 
-import subprocess
-import sys
 
 import numpy as np
 from PIL import Image
 
-from beltsim.animate import frame_fields
-from beltsim.results import read_snapshots
-
-
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "beltsim.cli", *args], capture_output=True,
-                          text=True, timeout=600)
+from beltsim.io.results import read_snapshots
+from beltsim.plots.animate import frame_fields
+from helpers import cli, scene_path
 
 
 def test_animate_runs_and_stores_a_gif_then_mp4_from_the_stored_run(tmp_path):
     run_dir = tmp_path / "run"
-    proc = _cli("animate", "runs/paper_slip.toml", "--set", "numerics.elements=150",
+    proc = cli("animate", scene_path("paper_slip"), "--set", "numerics.elements=150",
                 "--interval", "0.01", "--fps", "5", "--out", str(run_dir), "--quiet")
     assert proc.returncode == 0, proc.stderr
     gif = Image.open(run_dir / "transient.gif")
     assert gif.n_frames > 5
     stamp = (run_dir / "summary.json").stat().st_mtime_ns
     out = tmp_path / "mp4"
-    proc = _cli("animate", "--from", str(run_dir), "--format", "mp4", "--out", str(out))
+    proc = cli("animate", "--from", str(run_dir), "--format", "mp4", "--out", str(out))
     assert proc.returncode == 0, proc.stderr
     data = (out / "transient.mp4").read_bytes()
     assert len(data) > 10_000 and data[4:8] == b"ftyp"
@@ -32,7 +26,7 @@ def test_animate_runs_and_stores_a_gif_then_mp4_from_the_stored_run(tmp_path):
 
 
 def test_snapshots_settle_on_the_stored_final_state(tmp_path):
-    proc = _cli("run", "runs/paper_inertia.toml", "--set", "numerics.elements=150",
+    proc = cli("run", scene_path("paper_inertia"), "--set", "numerics.elements=150",
                 "--snapshots", "0.005", "--out", str(tmp_path), "--quiet")
     assert proc.returncode == 0, proc.stderr
     snaps = read_snapshots(tmp_path / "snapshots.npz")
@@ -48,6 +42,6 @@ def test_snapshots_settle_on_the_stored_final_state(tmp_path):
 
 
 def test_missing_snapshots_is_a_clean_error(tmp_path):
-    proc = _cli("animate", "--from", str(tmp_path))
+    proc = cli("animate", "--from", str(tmp_path))
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1
     assert "snapshots.npz" in proc.stderr and "Traceback" not in proc.stderr

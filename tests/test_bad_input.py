@@ -10,9 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import beltsim
-from beltsim.scene import paper_scene
+from beltsim.problem.scene import paper_scene
+from helpers import scene_path
 
-PAPER = open("runs/paper_slip.toml").read()
+PAPER = open(scene_path("paper_slip")).read()
 
 CORPUS = {
     "malformed": ("[beam\nlength = 1", "malformed TOML"),
@@ -106,23 +107,23 @@ def test_missing_and_unreadable_files(tmp_path, _cli):
 ])
 def test_bad_set(tmp_path, _cli, assignment, fragment):
     out = tmp_path / "out"
-    _assert_clean_error(_cli("run", "runs/paper_slip.toml", "--set", assignment, "--out",
+    _assert_clean_error(_cli("run", scene_path("paper_slip"), "--set", assignment, "--out",
                              str(out)), fragment, out)
 
 
 def test_output_directory_that_cannot_be_written(tmp_path, _cli):
     blocker = tmp_path / "file"
     blocker.write_text("x")
-    _assert_clean_error(_cli("run", "runs/paper_slip.toml", "--out", str(blocker / "sub")),
+    _assert_clean_error(_cli("run", scene_path("paper_slip"), "--out", str(blocker / "sub")),
                         "--out")
-    _assert_clean_error(_cli("analytic", "runs/paper_slip.toml", "--out", str(blocker)),
+    _assert_clean_error(_cli("analytic", scene_path("paper_slip"), "--out", str(blocker)),
                         "exists and is not a directory")
 
 
 def test_bad_options(tmp_path, _cli):
-    _assert_clean_error(_cli("convergence", "runs/paper_slip.toml", "--ladder", "10,x"),
+    _assert_clean_error(_cli("convergence", scene_path("paper_slip"), "--ladder", "10,x"),
                         "--ladder")
-    _assert_clean_error(_cli("sweep", "runs/paper_slip.toml", "--vary", "beam.length"),
+    _assert_clean_error(_cli("sweep", scene_path("paper_slip"), "--vary", "beam.length"),
                         "--vary")
     _assert_clean_error(_cli("run"), "give a SCENE")
     _assert_clean_error(_cli("run", "--resume", str(tmp_path)), "cannot read checkpoint")

@@ -3,68 +3,81 @@
 import numpy as np
 import pytest
 
-from beltsim.friction import LAW_CODES, LINEAR, RAMP, SQRT, TANH, law, law_inverse, law_numpy
-from beltsim.grid import make_grid
-from beltsim.integrators import Workspace, newton
-from beltsim.model import (I_DUAL, assemble, block_solve, blocks_to_dense, ramp, residual_numpy,
-                           update_multipliers)
-from beltsim.numerics import build_grid, pack, resolve, scales
-from beltsim.scene import Scene
+from beltsim.physics.friction import (
+    LAW_CODES,
+    LINEAR,
+    RAMP,
+    SQRT,
+    TANH,
+    law,
+    law_inverse,
+    law_numpy,
+)
+from beltsim.physics.grid import make_grid
+from beltsim.physics.model import (
+    State,
+    assemble,
+    block_solve,
+    blocks_to_dense,
+    residual_numpy,
+    update_multipliers,
+)
+from beltsim.problem.drive import ramp
+from beltsim.problem.scene import Scene
+from beltsim.solvers import Discretisation
+from beltsim.solvers.newton import NewtonSettings, Workspace, newton
+from helpers import scene_path
 
-PAPER = "runs/paper_slip.toml"
 
-
-def _setup(overrides=(), N=40):
-    sc = Scene.load(PAPER).with_overrides([f"numerics.elements={N}", *overrides])
-    num = resolve(sc)
-    grid = build_grid(sc, num)
-    prm, iprm = pack(sc.params, num, grid)
-    return sc, num, grid, prm, iprm
+def _setup(overrides=(), N=40, dual=0):
+    sc = Scene.load(scene_path("paper_slip")).with_overrides([f"numerics.elements={N}",
+                                                              *overrides])
+    d = Discretisation(sc)
+    return d, d.grid, d.model._replace(dual=dual)
 
 
 def _random_state(grid, seed, amp=1e-3):
+    """Trial (u, theta) and a previous step (values and local velocities)."""
     rng = np.random.default_rng(seed)
     n = len(grid.x)
     arrs = [amp * rng.standard_normal(n) for _ in range(6)]
     for a in arrs:
         a[0] = a[-1] = 0.0
-    return arrs
+    u, th, uo, tho, udo, tdo = arrs
+    zero = np.zeros(n)
+    return u, th, State(uo, tho, zero.copy(), udo, tdo, zero.copy())
 
 
-def _assemble(u, th, lam, old, inv_dt, t, grid, prm, iprm):
-    N = grid.n_elements
-    w = Workspace(N)
-    assemble(u, th, lam, *old, inv_dt, t, grid.he, grid.hbar, prm, iprm, w.R, w.Lb, w.Db, w.Ub,
-             w.fnode, w.rl, w.sg, True)
-    return w
+def _assemble(d, u, th, lam, old, inv_dt, t, p):
+    w = Workspace.allocate(d.grid.n_elements)
+    fnode = np.zeros_like(u)
+    assemble(u, th, lam, fnode, old, inv_dt, t, d.mesh, p, d.drive, w, True)
+    return w, fnode
 
 
 @pytest.mark.parametrize("law_name", ["tanh", "sqrt", "ramp"])
 @pytest.mark.parametrize("inertia", [True, False])
 def test_residual_matches_numpy_twin(law_name, inertia):
-    sc, num, grid, prm, iprm = _setup([f"numerics.friction_law={law_name}",
-                                       f"physics.inertia={str(inertia).lower()}"])
-    iprm[I_DUAL] = 0
-    u, th, uo, tho, udo, tdo = _random_state(grid, 1)
+    d, grid, p = _setup([f"numerics.friction_law={law_name}",
+                         f"physics.inertia={str(inertia).lower()}"])
+    u, th, old = _random_state(grid, 1)
     lam = np.zeros_like(u)
-    w = _assemble(u, th, lam, (uo, tho, udo, tdo), 1e4, 0.005, grid, prm, iprm)
-    R, F = residual_numpy(u, th, uo, tho, udo, tdo, 1e4, 0.005, grid.he, grid.hbar, prm, iprm)
+    w, fnode = _assemble(d, u, th, lam, old, 1e4, 0.005, p)
+    R, F = residual_numpy(u, th, old, 1e4, 0.005, d.mesh, p, d.drive)
     np.testing.assert_allclose(w.R, R, rtol=1e-12, atol=1e-9 * np.abs(R).max())
-    np.testing.assert_allclose(w.fnode, F, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(fnode, F, rtol=1e-12, atol=1e-12)
 
 
 @pytest.mark.parametrize("law_name", ["tanh", "sqrt"])
 def test_dual_residual_equals_primal_when_multiplier_consistent(law_name):
     """With lam = g(v_rel/v_reg) the condensed (dual) residual is the primal one."""
-    sc, num, grid, prm, iprm = _setup([f"numerics.friction_law={law_name}"])
-    u, th, uo, tho, udo, tdo = _random_state(grid, 2, amp=1e-6)
-    iprm[I_DUAL] = 0
+    d, grid, p = _setup([f"numerics.friction_law={law_name}"])
+    u, th, old = _random_state(grid, 2, amp=1e-6)
     lam = np.zeros_like(u)
-    wp = _assemble(u, th, lam, (uo, tho, udo, tdo), 1e4, 1.0, grid, prm, iprm)
-    iprm[I_DUAL] = 1
+    wp, _ = _assemble(d, u, th, lam, old, 1e4, 1.0, p)
     lam_d = np.clip(lam, -0.999, 0.999)  # keep inside the dual's domain
     keep = np.abs(lam) < 0.999
-    wd = _assemble(u, th, lam_d, (uo, tho, udo, tdo), 1e4, 1.0, grid, prm, iprm)
+    wd, _ = _assemble(d, u, th, lam_d, old, 1e4, 1.0, p._replace(dual=1))
     rows = keep[1:-1]
     np.testing.assert_allclose(wd.R[rows], wp.R[rows], rtol=1e-7,
                                atol=1e-7 * np.abs(wp.R).max())
@@ -73,12 +86,10 @@ def test_dual_residual_equals_primal_when_multiplier_consistent(law_name):
 @pytest.mark.parametrize("law_name", ["tanh", "sqrt", "ramp"])
 @pytest.mark.parametrize("inv_dt", [0.0, 3e3])
 def test_jacobian_matches_finite_differences(law_name, inv_dt):
-    sc, num, grid, prm, iprm = _setup([f"numerics.friction_law={law_name}",
-                                       "numerics.regularisation=0.05"])
-    iprm[I_DUAL] = 0
-    u, th, uo, tho, udo, tdo = _random_state(grid, 3, amp=1e-4)
+    d, grid, p = _setup([f"numerics.friction_law={law_name}", "numerics.regularisation=0.05"])
+    u, th, old = _random_state(grid, 3, amp=1e-4)
     lam = np.zeros_like(u)
-    w = _assemble(u, th, lam, (uo, tho, udo, tdo), inv_dt, 1.0, grid, prm, iprm)
+    w, _ = _assemble(d, u, th, lam, old, inv_dt, 1.0, p)
     J = blocks_to_dense(w.Lb, w.Db, w.Ub)
     n = grid.n_elements - 1
     Jfd = np.zeros_like(J)
@@ -92,8 +103,7 @@ def test_jacobian_matches_finite_differences(law_name, inv_dt):
             yy[k] += sgn * step
             uu, tt = u.copy(), th.copy()
             uu[1:-1], tt[1:-1] = yy[0::2], yy[1::2]
-            res.append(residual_numpy(uu, tt, uo, tho, udo, tdo, inv_dt, 1.0, grid.he,
-                                      grid.hbar, prm, iprm)[0].ravel())
+            res.append(residual_numpy(uu, tt, old, inv_dt, 1.0, d.mesh, p, d.drive)[0].ravel())
         Jfd[:, k] = (res[0] - res[1]) / (2 * step)
     scale = np.abs(J).max(axis=1, keepdims=True)
     np.testing.assert_allclose(J / scale, Jfd / scale, atol=1e-5)
@@ -137,45 +147,43 @@ def test_law_inverse_inverts_law(code):
 def test_dual_newton_solution_satisfies_primal_equations():
     """Independent check of the condensed solve and update_multipliers: the converged
     state of a hard implicit step satisfies the primal residual of the numpy twin."""
-    sc, num, grid, prm, iprm = _setup(N=200)
-    assert iprm[I_DUAL] == 1
-    N = grid.n_elements
-    w = Workspace(N)
-    u, th, lam = np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1)
-    zeros = np.zeros(N + 1)
-    sca = scales(sc.params)
+    d, grid, _ = _setup(N=200)
+    p = d.model
+    assert p.dual == 1
+    w = Workspace.allocate(grid.n_elements)
+    state, rest = d.new_state(), d.new_state()
     # a large step from rest at full surface speed: stick and slip nodes side by side
-    ok = newton(u, th, lam, zeros, zeros, zeros, zeros, 1.0 / 2e-3, 1.0, grid.he, grid.hbar,
-                prm, iprm, sca, 1e-11, 60, w.R, w.Lb, w.Db, w.Ub, w.C, w.dx, w.u_try,
-                w.th_try, w.fnode, w.rl, w.sg, w.stats)
+    ok = newton(state, rest, 1.0 / 2e-3, 1.0, d.mesh, p, d.drive, d.scales,
+                NewtonSettings(1e-11, 60), w)
     assert ok
-    iprm[I_DUAL] = 0
-    R, F = residual_numpy(u, th, zeros, zeros, zeros, zeros, 1.0 / 2e-3, 1.0, grid.he,
-                          grid.hbar, prm, iprm)
+    R, F = residual_numpy(state.u, state.theta, rest, 1.0 / 2e-3, 1.0, d.mesh,
+                          p._replace(dual=0), d.drive)
     # forces per node are O(f* h) ~ 1e2 N; round-off of the 1e-11 Newton tolerance
-    assert np.abs(R[:, 0]).max() < 1e-6 * sca[0]
-    np.testing.assert_allclose(w.fnode, F, atol=1e-9 * sc.params.fstar * grid.he.max())
+    assert np.abs(R[:, 0]).max() < 1e-6 * d.scales.force
+    np.testing.assert_allclose(state.fnode, F, atol=1e-9 * d.params.fstar * grid.he.max())
+    lam = state.lam
     sliding = np.abs(lam[grid.j1 + 1:grid.j2 + 1]) > 0.99
     assert sliding.sum() >= 2 and (~sliding).sum() >= 2
 
 
 def test_update_multipliers_stays_inside_and_follows_linearisation():
-    sc, num, grid, prm, iprm = _setup(N=20)
+    d, grid, p = _setup(N=20, dual=1)
+    w = Workspace.allocate(grid.n_elements)
     lam = np.zeros(len(grid.x))
     lam[grid.j1 + 1:grid.j2 + 1] = 0.5
-    rl = np.zeros_like(lam)
-    sg = np.ones_like(lam) * 0.75
+    rl, sg = w.rl, w.sg
+    sg[:] = 0.75
     dx = np.zeros((grid.n_elements - 1, 2))
     # a huge push towards +1: the 99% fraction-to-boundary rule applies
     rl[grid.j1 + 1:grid.j2 + 1] = 100.0
-    big = update_multipliers(lam, dx, 0.0, grid.he, prm, iprm, rl, sg)
+    big = update_multipliers(lam, dx, 0.0, d.mesh, p, w)
     contact = slice(grid.j1 + 1, grid.j2 + 1)
     np.testing.assert_allclose(lam[contact], 0.5 + 0.99 * 0.5)
     assert big == pytest.approx(0.495)
     # a small push: the linearised update sg * rl
     lam[contact] = 0.0
     rl[contact] = 0.1
-    update_multipliers(lam, dx, 0.0, grid.he, prm, iprm, rl, sg)
+    update_multipliers(lam, dx, 0.0, d.mesh, p, w)
     np.testing.assert_allclose(lam[contact], 0.075)
 
 
@@ -202,5 +210,5 @@ def test_grid_has_nodes_at_contact_ends(grading):
 
 
 def test_law_codes_cover_scene_choices():
-    from beltsim.scene import SCHEMA
+    from beltsim.problem.scene import SCHEMA
     assert set(SCHEMA["numerics"]["friction_law"].choices) <= set(LAW_CODES)

@@ -5,7 +5,7 @@ import sys
 
 import pytest
 
-from beltsim import paper
+from beltsim.studies import paper
 
 # Table 1 of Oborin & Vetyukov (2019), N: the published numbers
 PUBLISHED = {"No inertia, no slip": (6482, 6237, 12719),

@@ -3,16 +3,15 @@ a ValueError from the API and exit status 2 without a traceback from the CLI."""
 
 import copy
 import math
-import subprocess
-import sys
 import tomllib
 
 import pytest
 
 from beltsim.errors import SceneError
-from beltsim.scene import SCHEMA, Scene, load_scene
+from beltsim.problem.scene import SCHEMA, Scene, load_scene
+from helpers import scene_path
 
-with open("runs/paper_slip.toml", "rb") as fh:
+with open(scene_path("paper_slip"), "rb") as fh:
     BASE = tomllib.load(fh)  # coulomb, inertia
 
 
@@ -40,7 +39,7 @@ def _error(data):
 
 def test_paper_scenes_are_valid():
     for name in ("quasistatic", "inertia", "slip"):
-        load_scene(f"runs/paper_{name}.toml")
+        load_scene(scene_path(f"paper_{name}"))
     assert BASE["contact"]["start"] == 1 / 3 and BASE["contact"]["end"] == 2 / 3
 
 
@@ -147,21 +146,21 @@ def test_stiffness_overrides_take_effect():
 
 
 def test_set_overrides():
-    s = load_scene("runs/paper_slip.toml", ["contact.max_friction=2e5",
+    s = load_scene(scene_path("paper_slip"), ["contact.max_friction=2e5",
                                              "contact.friction=coulomb"])
     assert s.params.fstar == 2e5
     with pytest.raises(SceneError, match=r"^contact\.nope: unknown key"):
-        load_scene("runs/paper_slip.toml", ["contact.nope=1"])
+        load_scene(scene_path("paper_slip"), ["contact.nope=1"])
     with pytest.raises(SceneError, match=r"^nope\.x: unknown section"):
-        load_scene("runs/paper_slip.toml", ["nope.x=1"])
+        load_scene(scene_path("paper_slip"), ["nope.x=1"])
     with pytest.raises(SceneError, match=r"^contact\.max_friction: must be > 0"):
-        load_scene("runs/paper_slip.toml", ["contact.max_friction=-5"])
+        load_scene(scene_path("paper_slip"), ["contact.max_friction=-5"])
     with pytest.raises(SceneError, match=r"^contact\.max_friction: must be finite"):
-        load_scene("runs/paper_slip.toml", ["contact.max_friction=nan"])
+        load_scene(scene_path("paper_slip"), ["contact.max_friction=nan"])
     with pytest.raises(SceneError, match=r"expected SECTION\.KEY=VALUE"):
-        load_scene("runs/paper_slip.toml", ["contact.max_friction"])
+        load_scene(scene_path("paper_slip"), ["contact.max_friction"])
     with pytest.raises(SceneError, match=r"cannot parse value"):
-        load_scene("runs/paper_slip.toml", ["beam.length=1..2"])
+        load_scene(scene_path("paper_slip"), ["beam.length=1..2"])
 
 
 def test_files(tmp_path):
@@ -180,6 +179,6 @@ def test_files(tmp_path):
 
 
 def test_round_trip_through_toml():
-    s = load_scene("runs/paper_slip.toml", ["numerics.elements=300"])
+    s = load_scene(scene_path("paper_slip"), ["numerics.elements=300"])
     again = Scene(tomllib.loads(s.to_toml()))
     assert again.to_dict() == s.to_dict()

@@ -4,16 +4,23 @@ import numpy as np
 import pytest
 
 import beltsim
-from beltsim.friction import law_numpy
-from beltsim.integrators import (_friction_scalar, advance_explicit, explicit_amplification,
-                                  explicit_stable_dt)
-from beltsim.numerics import build_grid, pack, resolve
-from beltsim.runner import GROWTH_LIMIT, Simulation
-from beltsim.scene import Scene
+from beltsim.physics.friction import law_numpy
+from beltsim.physics.model import State
+from beltsim.problem.scene import Scene
+from beltsim.simulation.controller import Simulation
+from beltsim.simulation.trackers import GROWTH_LIMIT
+from beltsim.solvers import Discretisation
+from beltsim.solvers.explicit import (
+    _friction_scalar,
+    advance_explicit,
+    explicit_amplification,
+    explicit_stable_dt,
+)
+from helpers import scene_path
 
 
 def _scene(name, *overrides):
-    return beltsim.load_scene(f"runs/{name}.toml", ["numerics.elements=300", *overrides])
+    return beltsim.load_scene(scene_path(name), ["numerics.elements=300", *overrides])
 
 
 @pytest.fixture(scope="module")
@@ -74,36 +81,31 @@ def test_explicit_limit_is_sharp():
     def run_with(dt_factor):
         sc = _scene("paper_inertia", "numerics.grading=1", "numerics.elements=200",
                     "motion.surface_speed=120")
-        num = resolve(sc)
-        grid = build_grid(sc, num)
-        P = sc.params
-        limit = explicit_stable_dt(P, grid.h_min, num.damping)
-        prm, iprm = pack(P, num, grid)
-        n = len(grid.x)
+        d = Discretisation(sc)
+        limit = explicit_stable_dt(d.params, d.grid.h_min, d.numerics.damping)
+        state = d.new_state()
         rng = np.random.default_rng(0)
-        u = 1e-6 * rng.standard_normal(n)
-        th = 1e-6 * rng.standard_normal(n)
-        u[[0, -1]] = th[[0, -1]] = 0.0
-        v, w, s, f = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-        advance_explicit(u, th, v, w, s, 0.0, 1.0, dt_factor * limit, 20000, grid.he,
-                         grid.hbar, prm, iprm, f)
-        return np.abs(u).max() / 1e-6
+        state.u[1:-1] = 1e-6 * rng.standard_normal(len(state.u) - 2)
+        state.theta[1:-1] = 1e-6 * rng.standard_normal(len(state.u) - 2)
+        advance_explicit(state, 0.0, 1.0, dt_factor * limit, 20000, d.mesh, d.model, d.drive)
+        return np.abs(state.u).max() / 1e-6
     assert run_with(0.95) < 10.0
     assert not run_with(1.3) < GROWTH_LIMIT  # overflowed or grew by > 1e4
 
 
 def test_amplification_is_one_for_a_tiny_step_and_exceeds_one_beyond_cfl():
-    P = Scene.load("runs/paper_inertia.toml").params
+    P = Scene.load(scene_path("paper_inertia")).params
     h = 1e-3
     assert explicit_amplification(P, h, 1e-12, 651.0) <= 1.0 + 1e-12
     speed = P.c + np.sqrt(P.b1 / P.rho)
     assert explicit_amplification(P, h, 1.5 * h / speed, 651.0) > 1.01
 
 
-def _explicit_step_numpy(u, th, v, w, sfr, t, dt, he, hb, prm, iprm, P, num):
+def _explicit_step_numpy(u, th, v, w, dt, mesh, P, num):
     """Numpy twin of one explicit step (without the per-node scalar solver's shortcut)."""
     from scipy.optimize import brentq
     c, hh, d = P.c, 0.5 * P.h, num.damping
+    he, hb = mesh.he, mesh.hb
     m, mi = P.rho * hb, P.I * hb
     vn, wn = v.copy(), w.copy()
     j = np.arange(1, len(u) - 1)
@@ -114,9 +116,9 @@ def _explicit_step_numpy(u, th, v, w, sfr, t, dt, he, hb, prm, iprm, P, num):
                                  - P.b2 * hb[j] * th[j] - 2 * P.I * c * hb[j] * (w[j] - w[j - 1])
                                  / hl - d * mi[j] * w[j])
     ub = u + hh * th
-    target = (P.v - P.c) * min(1.0, 1.0)
+    target = P.v - P.c  # the scene has no ramp
     F = np.zeros_like(u)
-    for k in range(iprm[1] + 1, iprm[2] + 1):
+    for k in range(mesh.j1 + 1, mesh.j2 + 1):
         h = he[k - 1]
         base = vn[k] + hh * wn[k] + c * (ub[k] - ub[k - 1]) / h - target
         # v_rel = base + dt F (1/m + hh^2/mi), F = -h f* g(v_rel / v_reg)
@@ -136,19 +138,17 @@ def test_explicit_step_matches_numpy_twin():
     sc = _scene("paper_slip", "numerics.integrator=explicit", "numerics.elements=60",
                 "numerics.ramp_time=0")
     sim = Simulation(sc)
+    d, dt = sim.disc, sim.numerics.dt
     rng = np.random.default_rng(5)
     n = len(sim.grid.x)
     u, th, v, w = (1e-4 * rng.standard_normal(n) for _ in range(4))
     for a in (u, th, v, w):
         a[[0, -1]] = 0.0
-    ref = _explicit_step_numpy(u, th, v, w, None, 0.0, sim.numerics.dt, sim.he, sim.hb,
-                               sim.prm, sim.iprm, sc.params, sim.numerics)
-    f = np.zeros(n)
-    s = np.zeros(n)
-    uu, tt, vv, ww = u.copy(), th.copy(), v.copy(), w.copy()
-    advance_explicit(uu, tt, vv, ww, s, 0.0, 1e-30, sim.numerics.dt, 1, sim.he, sim.hb,
-                     sim.prm, sim.iprm, f)
-    for got, want in zip((uu, tt, vv, ww, f), ref):
+    ref = _explicit_step_numpy(u, th, v, w, dt, d.mesh, sc.params, sim.numerics)
+    state = State(u.copy(), th.copy(), np.zeros(n), v.copy(), w.copy(), np.zeros(n))
+    advance_explicit(state, 0.0, 1e-30, dt, 1, d.mesh, d.model, d.drive)
+    got = (state.u, state.theta, state.ud, state.td, state.fnode)
+    for got, want in zip(got, ref):
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
 
 

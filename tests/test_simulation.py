@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import beltsim
-from beltsim.friction import law_numpy
-from beltsim.results import read_csv
+from beltsim.io.files import read_csv
+from beltsim.physics.friction import law_numpy
 
 RUNS = "runs"
 # The acceptance bounds (independent of the code): relative errors of the

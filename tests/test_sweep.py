@@ -8,9 +8,10 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 
-from beltsim import sweep
 from beltsim.errors import SceneError, UsageError
-from beltsim.scene import paper_scene
+from beltsim.problem.scene import paper_scene
+from beltsim.studies import sweep
+from helpers import scene_path
 
 F_STARS = (5e4, 7e4, 1e5, 2e5, 5e5, 1e6)
 
@@ -58,7 +59,7 @@ def test_parse_vary_validates():
 
 def test_sweep_command_writes_csv_and_figure(tmp_path):
     proc = subprocess.run(
-        [sys.executable, "-m", "beltsim.cli", "sweep", "runs/paper_slip.toml", "--vary",
+        [sys.executable, "-m", "beltsim.cli", "sweep", scene_path("paper_slip"), "--vary",
          "contact.max_friction=5e4,1e5,1e6", "--set", "numerics.elements=300", "--workers",
          "2", "--out", str(tmp_path)], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
@@ -79,7 +80,7 @@ def test_scheduler_without_dask_is_a_clean_error(tmp_path):
     except ImportError:
         pass
     proc = subprocess.run(
-        [sys.executable, "-m", "beltsim.cli", "sweep", "runs/paper_slip.toml", "--vary",
+        [sys.executable, "-m", "beltsim.cli", "sweep", scene_path("paper_slip"), "--vary",
          "contact.max_friction=1e5", "--scheduler", "tcp://127.0.0.1:1", "--out",
          str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and "dask" in proc.stderr.lower()

@@ -14,7 +14,6 @@ import numpy as np
 
 from ..errors import SceneError
 
-
 #: The fewest elements of a grid: two in each of [0, x1], [x1, x2], [x2, L].
 MIN_ELEMENTS = 6
 

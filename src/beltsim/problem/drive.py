@@ -4,7 +4,7 @@ A run starts from rest with the surface moving at the belt speed c and takes it
 smoothly to v over ``ramp_time``: the mismatch v(t) - c = (v - c) s(t / ramp_time)
 with the C2 smoothstep s(r) = r^3 (10 - 15 r + 6 r^2), which starts and ends with
 zero velocity and acceleration, so the ramp itself excites no jump in the belt.
-The steady solver's continuation walks through the same ramp.
+The steady solver's continuation scales the same mismatch from 0 to 1.
 
 ``Drive`` is the named structure the kernels read (numba compiles namedtuples).
 """
@@ -36,17 +36,3 @@ def ramp(t, t_ramp):
 def mismatch(drive, t):
     """v(t) - c."""
     return drive.mismatch * ramp(t, drive.ramp_time)
-
-
-def ramp_inverse(s: float) -> float:
-    """The r in [0, 1] with ramp(r, 1) = s (bisection; the smoothstep is monotone)."""
-    if s >= 1.0:
-        return 1.0
-    lo, hi = 0.0, 1.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if ramp(mid, 1.0) < s:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)

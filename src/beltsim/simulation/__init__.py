@@ -1,1 +1,1 @@
-"""The run loop: a controller with trackers, the result of a run, the discrete state read as a solution."""
+"""The run loop: a controller with trackers, a run's result, the state read as a solution."""

@@ -19,9 +19,17 @@ from ..physics.grid import Grid
 from ..problem.scene import Scene
 from .result import RunResult, RunStatus
 from .solution import DiscreteSolution
-from .trackers import (CallbackTracker, CheckpointTracker, DivergenceGuard, HistoryTracker,
-                       ProgressTracker, SignalTracker, SnapshotTracker, SteadyStateTracker,
-                       Tracker)
+from .trackers import (
+    CallbackTracker,
+    CheckpointTracker,
+    DivergenceGuard,
+    HistoryTracker,
+    ProgressTracker,
+    SignalTracker,
+    SnapshotTracker,
+    SteadyStateTracker,
+    Tracker,
+)
 
 CHECKS_PER_TRANSIT = 4  # checks per transit time L / c
 

@@ -29,7 +29,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-
 from ..errors import SceneError
 from ..physics.friction import LAW_CODES
 from ..physics.grid import Grid, make_grid
