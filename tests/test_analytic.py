@@ -1,6 +1,6 @@
 """Analytic solutions checked against the steady equations, independently of their formulas.
 
-Equations (shared/NOTES.md), B = b1 - rho c^2, A = a - I c^2:
+Equations (the paper's, as in beltsim.problem.analytic), B = b1 - rho c^2, A = a - I c^2:
   B eps' + f = 0,  A theta'' - b2 theta + (h/2) f = 0,  eps + (h/2) theta' = e0 in stick,
   theta = 0 at 0 and L, integral of eps = 0, [[B eps]] = -F and [[A theta']] = -(h/2) F at x2.
 Derivatives here are finite differences of the returned u, theta and strain, never the

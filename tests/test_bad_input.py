@@ -6,7 +6,7 @@ import subprocess
 import sys
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import beltsim
@@ -137,24 +137,19 @@ def test_bad_options(tmp_path, _cli):
        inertia=st.booleans())
 def test_valid_scenes_converge_within_bounds_or_are_refused(L, x1f, x2f, cfrac, e0, logf,
                                                             inertia):
-    """Across the valid ranges: converged within the bounds for a coarse grid, or refused
-    with a reason; never NaN, never a silent wrong number."""
+    """Across the valid ranges every scene runs: converged within the bounds for a coarse
+    grid, with an analytic state to compare with; never NaN, never a silent wrong number.
+    A mismatch below 1e-8 is refused by rule (round-off of v - c), so it is not drawn."""
+    assume(abs(e0) >= 1e-6)
     P0 = paper_scene("slip").params
     c = cfrac * min(math.sqrt(P0.b1 / P0.rho), math.sqrt(P0.a / P0.I))
     over = [f"beam.length={L}", f"contact.start={x1f * L}", f"contact.end={x2f * L}",
             f"motion.belt_speed={c}", f"motion.surface_speed={c * (1 + e0)}",
             f"contact.max_friction={10 ** logf}", f"physics.inertia={str(inertia).lower()}",
             "numerics.elements=400"]
-    try:
-        scene = paper_scene("slip", over)
-        result = beltsim.run(scene, raise_on_failure=False)
-    except beltsim.BeltsimError as exc:
-        assert str(exc)  # refused with a reason
-        return
+    result = beltsim.run(paper_scene("slip", over), raise_on_failure=False)
     assert result.converged, result.reason
     err = result.errors()
-    if err is None:  # no admissible analytic state to compare with: nothing to bound
-        return
     # 400 elements: first-order errors ~2.5x those of the default grid; the bounds are
     # the simulator's (0.5% friction, 2% u) widened by that factor
     assert err["total_friction"] < 0.0125 and err["u"] < 0.05

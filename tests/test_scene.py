@@ -149,18 +149,19 @@ def test_set_overrides():
     s = load_scene(scene_path("paper_slip"), ["contact.max_friction=2e5",
                                              "contact.friction=coulomb"])
     assert s.params.fstar == 2e5
-    with pytest.raises(SceneError, match=r"^contact\.nope: unknown key"):
-        load_scene(scene_path("paper_slip"), ["contact.nope=1"])
-    with pytest.raises(SceneError, match=r"^nope\.x: unknown section"):
-        load_scene(scene_path("paper_slip"), ["nope.x=1"])
-    with pytest.raises(SceneError, match=r"^contact\.max_friction: must be > 0"):
-        load_scene(scene_path("paper_slip"), ["contact.max_friction=-5"])
-    with pytest.raises(SceneError, match=r"^contact\.max_friction: must be finite"):
-        load_scene(scene_path("paper_slip"), ["contact.max_friction=nan"])
-    with pytest.raises(SceneError, match=r"expected SECTION\.KEY=VALUE"):
-        load_scene(scene_path("paper_slip"), ["contact.max_friction"])
-    with pytest.raises(SceneError, match=r"cannot parse value"):
-        load_scene(scene_path("paper_slip"), ["beam.length=1..2"])
+
+
+@pytest.mark.parametrize("assignment, message", [
+    ("contact.nope=1", r"^contact\.nope: unknown key"),
+    ("nope.x=1", r"^nope\.x: unknown section"),
+    ("contact.max_friction=-5", r"^contact\.max_friction: must be > 0"),
+    ("contact.max_friction=nan", r"^contact\.max_friction: must be finite"),
+    ("contact.max_friction", r"expected SECTION\.KEY=VALUE"),
+    ("beam.length=1..2", r"cannot parse value"),
+])
+def test_bad_set_overrides(assignment, message):
+    with pytest.raises(SceneError, match=message):
+        load_scene(scene_path("paper_slip"), [assignment])
 
 
 def test_files(tmp_path):

@@ -10,8 +10,8 @@ import pytest
 import beltsim
 from beltsim.io.files import read_csv
 from beltsim.physics.friction import law_numpy
+from helpers import scene_path
 
-RUNS = "runs"
 # The acceptance bounds (independent of the code): relative errors of the
 # total friction 0.5%, of u and theta 2% (max over the grid, relative to the field's
 # max), of the concentrated force 5%; slip start within 5 mm.
@@ -23,7 +23,7 @@ COARSE = "numerics.elements=500"
 
 
 def _run(name, *overrides):
-    scene = beltsim.load_scene(f"{RUNS}/{name}.toml", [COARSE, *overrides])
+    scene = beltsim.load_scene(scene_path(name), [COARSE, *overrides])
     return beltsim.run(scene)
 
 
@@ -143,7 +143,7 @@ def test_run_stops_at_t_end_when_not_steady():
 def test_cli_run_writes_outputs(tmp_path):
     out = tmp_path / "run"
     proc = subprocess.run(
-        [sys.executable, "-m", "beltsim.cli", "run", f"{RUNS}/paper_slip.toml", "--out",
+        [sys.executable, "-m", "beltsim.cli", "run", scene_path("paper_slip"), "--out",
          str(out), "--set", "numerics.elements=300", "--quiet"],
         capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
@@ -164,7 +164,7 @@ def test_cli_run_writes_outputs(tmp_path):
 
 def test_cli_not_steady_exits_1(tmp_path):
     proc = subprocess.run(
-        [sys.executable, "-m", "beltsim.cli", "run", f"{RUNS}/paper_inertia.toml", "--out",
+        [sys.executable, "-m", "beltsim.cli", "run", scene_path("paper_inertia"), "--out",
          str(tmp_path), "--set", "numerics.elements=100", "--set", "numerics.t_end=0.005",
          "--quiet"], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 1

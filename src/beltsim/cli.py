@@ -84,8 +84,8 @@ def cmd_run(args):
         if not args.scene:
             raise UsageError("run: give a SCENE file, or --resume DIR")
         scene = _scene(args)
-        out = prepare_outdir(args.out or Path("runs/out") / Path(args.scene).stem)
         sim = Simulation(scene, snapshot_interval=args.snapshots)
+        out = prepare_outdir(args.out or Path("runs/out") / Path(args.scene).stem)
         title = scene.title or args.scene
     # a summary.json present means the latest run in this directory finished
     (out / "summary.json").unlink(missing_ok=True)
@@ -131,13 +131,13 @@ def cmd_convergence(args):
     from .studies import convergence as studies
 
     scene = _scene(args)
-    out = prepare_outdir(args.out or Path("runs/out") / f"convergence_{Path(args.scene).stem}")
     ladder = _int_list(args.ladder, "--ladder")
     schemes = args.schemes.split(",") if args.schemes else None
     known = (*solvers.names(), studies.RICHARDSON)
     for s in schemes or ():
         if s not in known:
             raise UsageError(f"--schemes: unknown scheme {s!r} ({', '.join(known)})")
+    out = prepare_outdir(args.out or Path("runs/out") / f"convergence_{Path(args.scene).stem}")
     cols = ("scheme", "elements", "h_min", "dt", "steps", "wall_time", "compile_time",
             "converged") + tuple(f"error_{k}" for k in studies.ERROR_KEYS)
     print("  ".join(f"{c:>12s}" for c in cols))

@@ -1,7 +1,7 @@
 """The discrete model: residual and Jacobian of the transient equations.
 
 Fields u, theta at the nodes of a fixed grid; the material flows through at
-speed c. With B = b1 - rho c^2 and A = a - I c^2 (``shared/NOTES.md``)::
+speed c, and D/Dt = d/dt + c d/dx. With B = b1 - rho c^2 and A = a - I c^2::
 
     rho (u_tt + 2 c u_xt) + d rho u_t = B u_xx + f
     I (theta_tt + 2 c theta_xt) + d I theta_t = A theta_xx - b2 theta + (h/2) f
@@ -13,8 +13,9 @@ transport c d/dx u_b in the slip velocity is upwind: the slip velocity of the
 element [x_{j-1}, x_j] uses the bottom-fibre strain of that element and the
 velocity of its downstream node j, and the element's friction is lumped on node
 j. Treated centrally this term makes the friction alternate in sign from node
-to node in stick zones (NOTES, trap 1). The damping d acts on local time
-derivatives only, so it vanishes at steady state (trap 3).
+to node in stick zones, and Newton can land on spurious all-slip states. The
+damping d acts on local time derivatives only, so it vanishes at steady state
+(damping of the material strain rate would not, and would change the answer).
 
 Time: the residual is written for backward Euler with ``inv_dt`` = 1/dt; with
 ``inv_dt`` = 0 it is the discrete steady problem. Interior nodes 1..N-1 carry

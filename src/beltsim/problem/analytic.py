@@ -14,8 +14,11 @@ quasistatic)::
 theta = 0 at x = 0, L; theta, A theta' and eps continuous except at x2 in the
 perfect-adhesion model, where the concentrated force F makes
 [[B eps]] = -F and [[A theta']] = -(h/2) F; the integral of eps over [0, L]
-is zero (material length). The printed formulas carry misprints (see
-``shared/NOTES.md``); nothing here is copied from them.
+is zero (material length). The printed formulas carry misprints, so nothing
+here is copied from them: in eq. (7) f_stick has a "+" between the exponentials
+(f = B (h/2) theta''); in eqs. (10) and (14) "cosh(beta x1)" must read
+1/sinh(beta x1) (and 1/sinh(beta (L - x2))); eq. (26) reads
+theta'' - beta^2 theta + beta^2 h f* / (2 b2) = 0; eq. (29) lacks "= 0".
 
 On each segment [p, q] theta = P e^{-k(x-p)} + Q e^{-k(q-x)} + theta_p: the
 two basis functions stay bounded for long segments (large k L) and well
@@ -218,10 +221,6 @@ class AnalyticSolution:
     @property
     def total_friction(self) -> float:
         return self.distributed_friction + self.concentrated_force
-
-    @property
-    def slip_start(self):
-        return self.x_star
 
     def summary(self) -> dict:
         stick_model = self.model == "stick"

@@ -194,6 +194,8 @@ def explicit_stable_dt(params, h_min, damping):
 
 @register
 class ExplicitScheme(Scheme):
+    """Staggered leapfrog at EXPLICIT_SAFETY of the von Neumann limit (inertial scenes)."""
+
     name = "explicit"
     needs_inertia = True
 

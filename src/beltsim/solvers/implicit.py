@@ -85,6 +85,8 @@ class NewtonScheme(Scheme):
         num = self.numerics
         self.work = Workspace.allocate(disc.grid.n_elements)
         self.settings = NewtonSettings(num.newton_tol, num.newton_max_it)
+        # the previous step's state (with inv_dt = 0, the steady equations ignore it)
+        self.old = disc.new_state()
 
     def statistics(self) -> dict:
         st = self.work.stats[0]
@@ -109,7 +111,6 @@ class ImplicitScheme(NewtonScheme):
     def __init__(self, disc):
         super().__init__(disc)
         self._dt = self.numerics.dt
-        self.old = disc.new_state()
 
     @property
     def dt(self) -> float:

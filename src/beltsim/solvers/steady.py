@@ -20,14 +20,10 @@ STAGE_ITERATIONS = 4  # Newton iterations per stage, in units of newton_max_iter
 
 @register
 class SteadyScheme(NewtonScheme):
+    """Newton on the steady equations with continuation in v - c; no time stepping."""
+
     name = "steady"
     transient = False
-
-    def __init__(self, disc):
-        super().__init__(disc)
-        self.old = disc.new_state()  # inv_dt = 0: the previous step does not enter
-        num = self.numerics
-        self.stage_settings = NewtonSettings(num.newton_tol, STAGE_ITERATIONS * num.newton_max_it)
 
     def _stage(self, state, s, settings):
         d = self.disc
@@ -45,11 +41,13 @@ class SteadyScheme(NewtonScheme):
 
         Raises NumericalError when the stage falls below MIN_STAGE of the mismatch.
         """
+        stage_settings = self.settings._replace(
+            max_iterations=STAGE_ITERATIONS * self.settings.max_iterations)
         s_done, ds = 0.0, 1.0
         while s_done < 1.0:
             s = min(1.0, s_done + ds)
             saved = state.copy()
-            ok = self._stage(state, s, self.stage_settings)
+            ok = self._stage(state, s, stage_settings)
             self.steps += 1
             if ok:
                 s_done, ds = s, 2.0 * ds
