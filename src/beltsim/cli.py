@@ -233,6 +233,7 @@ def cmd_sweep(args):
 def cmd_paper(args):
     from pathlib import Path
 
+    from .plots.paper import figures
     from .studies import paper
 
     sims = None
@@ -241,9 +242,12 @@ def cmd_paper(args):
             print(f"  simulated {key}: {'steady' if res.converged else 'NOT steady'} after "
                   f"{res.steps} steps, wall {res.wall_time:.3g} s", flush=True)
         sims = paper.simulate(progress=show)
-    result = paper.reproduce(args.out or Path("runs/out/paper"), simulated=sims)
-    print(paper.format_table1(result["table"]))
-    print("wrote " + ", ".join(str(p) for p in result["paths"]))
+    out = args.out or Path("runs/out/paper")
+    sols = paper.solutions()
+    rows, table = paper.write_table1(out, sols)
+    paths = [table, *figures(out, sols, sims)]
+    print(paper.format_table1(rows))
+    print("wrote " + ", ".join(str(p) for p in paths))
     return 0
 
 

@@ -1,11 +1,30 @@
-"""The paper's Figures 2-7: analytic curves, with simulated steady states as markers."""
+"""The paper's Figures 2-7: analytic curves, with simulated steady states as markers.
+
+Figures 2-6 have the paper's two panels: inertia against no inertia (both perfect
+adhesion), and slip against no slip (both with inertia); Figure 7 the rotation for
+three friction limits against perfect adhesion.
+"""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
-from ..studies.paper import FIG7_FSTAR, PANEL_TITLES, PANELS, STYLE
+from ..studies.paper import FIG7_FSTAR
 from .common import pyplot, save
+
+STYLE = {"quasistatic": ("tab:gray", "no inertia, no slip"),
+         "inertia": ("tab:blue", "inertia, no slip"),
+         "slip": ("tab:red", "inertia, slip (f* = 1e5 N/m)")}
+# (field, figure number, y label, title) of the two-panel figures
+FIGURES = (("friction", 2, "distributed friction f [N/m]", "Distributed friction force"),
+           ("tension", 3, "tension T [N]", "Tension"),
+           ("moment", 4, "moment M [N m]", "Moment"),
+           ("theta", 5, "angle theta [rad]", "Angle"),
+           ("u", 6, "displacement u [m]", "Displacement"))
+PANELS = (("quasistatic", "inertia"), ("inertia", "slip"))
+PANEL_TITLES = ("inertia versus no inertia", "slip versus no slip")
 
 
 def _markers(ax, sim, field, color):
@@ -72,3 +91,13 @@ def fig7(sols, sims, path):
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=9)
     return save(fig, path, dpi=120)
+
+
+def figures(out_dir, sols: dict, sims: dict | None = None) -> list[Path]:
+    """fig2.png ... fig7.png in ``out_dir`` (analytic solutions, optional simulated markers)."""
+    sims = sims or {}
+    paths = [two_panel(field, number, ylabel, title, sols, sims,
+                       Path(out_dir) / f"fig{number}.png")
+             for field, number, ylabel, title in FIGURES]
+    paths.append(fig7(sols, sims, Path(out_dir) / "fig7.png"))
+    return paths

@@ -112,7 +112,7 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "rotary_inertia": POS,
     },
     "numerics": {
-        "integrator": _Rule("str"),  # a registered scheme: checked in validate()
+        "integrator": _Rule("str"),  # a registered scheme: beltsim.solvers checks it
         "elements": _Rule("int", minimum=MIN_ELEMENTS),
         "grading": _Rule("float", minimum=1.0),
         "dt": POS,
@@ -206,12 +206,6 @@ def validate(data: dict) -> dict:
         if key in out.get(section, {}) and not inertia:
             raise SceneError(f"{section}.{key}: only for physics.inertia = true "
                              f"(a quasistatic scene has no inertia terms)")
-    integ = out.get("numerics", {}).get("integrator")
-    if integ is not None:
-        from .. import solvers  # the registry knows the schemes and what each needs
-        reason = solvers.applicable(integ, inertia)
-        if reason:
-            raise SceneError(reason)
 
     beam, contact = out["beam"], out["contact"]
     L, x1, x2 = beam["length"], contact["start"], contact["end"]

@@ -4,6 +4,7 @@ Importing this package registers every scheme (see :mod:`beltsim.solvers.base`).
 """
 
 from . import explicit, implicit, steady  # noqa: F401  (each registers its scheme)
-from .base import Discretisation, Scheme, applicable, get, names, register
+from .base import Discretisation, Scheme
+from .registry import applicable, get, names, register
 
 __all__ = ["Discretisation", "Scheme", "applicable", "get", "names", "register"]

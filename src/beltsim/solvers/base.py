@@ -1,11 +1,4 @@
-"""What every scheme works on, the interface every scheme offers, and the registry.
-
-A scheme is a class registered under its name (``numerics.integrator``): the CLI's
-choices, the scene schema, the studies' scheme lists and the stability matrix all
-come from :func:`names` and :func:`get`. Adding a scheme is one new module under
-``beltsim/solvers`` that defines a :class:`Scheme` subclass decorated with
-:func:`register`, and one import line in ``beltsim/solvers/__init__.py``.
-"""
+"""What every scheme works on (:class:`Discretisation`) and the interface it offers."""
 
 from __future__ import annotations
 
@@ -14,42 +7,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..errors import SceneError
 from ..physics.grid import Grid
 from ..physics.model import Mesh, ModelParams, State, mesh_of, model_params
 from ..problem.drive import Drive
 from ..problem.scene import Scene
 from .newton import Scales, scales_of
 from .settings import Numerics, build_grid, resolve
-
-_REGISTRY: dict[str, type["Scheme"]] = {}
-
-
-def register(cls):
-    """Class decorator: make a scheme available under ``cls.name``."""
-    _REGISTRY[cls.name] = cls
-    return cls
-
-
-def names() -> tuple[str, ...]:
-    return tuple(_REGISTRY)
-
-
-def get(name: str) -> type["Scheme"]:
-    try:
-        return _REGISTRY[name]
-    except KeyError:
-        raise SceneError(f"numerics.integrator: must be one of "
-                         f"{' | '.join(repr(n) for n in _REGISTRY)}, got {name!r}") from None
-
-
-def applicable(name: str, inertia: bool) -> str | None:
-    """Why a scheme does not apply to a scene (None when it does)."""
-    cls = get(name)
-    if cls.needs_inertia and not inertia:
-        return (f'numerics.integrator: "{name}" needs physics.inertia = true (a quasistatic '
-                f'scene has no dynamics to step explicitly)')
-    return None
 
 
 class Discretisation:
@@ -92,9 +55,6 @@ class Scheme:
     needs_inertia: ClassVar[bool] = False
 
     def __init__(self, disc: Discretisation):
-        reason = applicable(self.name, disc.params.inertia)
-        if reason:
-            raise SceneError(reason)
         self.disc = disc
         self.numerics = disc.numerics  # a scheme may settle some of them (the explicit dt)
         self.steps = 0

@@ -24,7 +24,8 @@ from numba import njit
 from ..errors import SceneError
 from ..physics.friction import LINEAR, RAMP, law
 from ..problem.drive import mismatch
-from .base import Scheme, register
+from .base import Scheme
+from .registry import register
 
 EXPLICIT_SAFETY = 0.9  # default explicit step as a fraction of the stability limit
 SMALL_STEP = 1e-5  # relative Newton step below which the friction solve stops

@@ -14,8 +14,9 @@ from numba import njit
 
 from ..errors import NumericalError
 from ..physics.model import State
-from .base import Scheme, register
+from .base import Scheme
 from .newton import NewtonSettings, Workspace, newton
+from .registry import register
 
 # status codes of advance_implicit
 OK, FAILED, NONFINITE = 0, 1, 2

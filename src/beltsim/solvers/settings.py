@@ -34,6 +34,7 @@ from ..physics.friction import LAW_CODES
 from ..physics.grid import Grid, make_grid
 from ..problem.analytic import decay_rates
 from ..problem.scene import Params, Scene
+from . import registry
 
 DEFAULT_ELEMENTS = 1000
 DEFAULT_GRADING = 8.0
@@ -76,6 +77,10 @@ def resolve(scene: Scene) -> Numerics:
     t_end = nm.get("t_end", ramp_time + 400.0 * transit)
     if dt > t_end:
         raise SceneError(f"numerics.dt: must be <= numerics.t_end = {t_end!r}, got {dt!r}")
+    integrator = nm.get("integrator", "implicit")
+    reason = registry.applicable(integrator, P.inertia)  # unknown names raise here
+    if reason:
+        raise SceneError(reason)
     if 0.0 < abs(P.e0) < MIN_MISMATCH:
         raise SceneError(
             f"motion.surface_speed: |v/c - 1| = {abs(P.e0):.3g} is below {MIN_MISMATCH:g} "
@@ -100,7 +105,7 @@ def resolve(scene: Scene) -> Numerics:
     else:
         damping = 0.0
     return Numerics(
-        integrator=nm.get("integrator", "implicit"),
+        integrator=integrator,
         elements=nm.get("elements", default_elements(P)),
         grading=nm.get("grading", DEFAULT_GRADING),
         dt=dt, t_end=t_end, ramp_time=ramp_time, law=law, vreg=vreg, fs=fs,

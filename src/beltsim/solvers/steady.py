@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from ..errors import NumericalError
 from ..problem.drive import Drive
-from .base import register
 from .implicit import NewtonScheme
 from .newton import NewtonSettings, newton
+from .registry import register
 
 MIN_STAGE = 1e-6  # smallest continuation stage, relative to the full mismatch
 STAGE_ITERATIONS = 4  # Newton iterations per stage, in units of newton_max_iterations

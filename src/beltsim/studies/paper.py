@@ -2,8 +2,7 @@
 
 Cases: "quasistatic" (no inertia, perfect adhesion), "inertia" (inertia, perfect
 adhesion) and "slip" (inertia, stick and slip, f* = 1e5 N/m), the scenes
-runs/paper_*.toml. Figures 2-6 have the paper's two panels: inertia against no
-inertia (both perfect adhesion), and slip against no slip (both with inertia).
+runs/paper_*.toml. The figures are drawn by :mod:`beltsim.plots.paper`.
 """
 
 from __future__ import annotations
@@ -19,17 +18,6 @@ from ..problem.scene import paper_scene
 CASES = {"quasistatic": "No inertia, no slip", "inertia": "With inertia, no slip",
          "slip": "With inertia, with slip"}
 FIG7_FSTAR = (0.5e5, 1e5, 2e5)
-STYLE = {"quasistatic": ("tab:gray", "no inertia, no slip"),
-         "inertia": ("tab:blue", "inertia, no slip"),
-         "slip": ("tab:red", "inertia, slip (f* = 1e5 N/m)")}
-# (field, figure number, y label, title) of the two-panel figures
-FIGURES = (("friction", 2, "distributed friction f [N/m]", "Distributed friction force"),
-           ("tension", 3, "tension T [N]", "Tension"),
-           ("moment", 4, "moment M [N m]", "Moment"),
-           ("theta", 5, "angle theta [rad]", "Angle"),
-           ("u", 6, "displacement u [m]", "Displacement"))
-PANELS = (("quasistatic", "inertia"), ("inertia", "slip"))
-PANEL_TITLES = ("inertia versus no inertia", "slip versus no slip")
 
 
 def solutions() -> dict:
@@ -91,21 +79,10 @@ def simulate(progress=None) -> dict:
     return out
 
 
-def reproduce(out_dir, simulated: dict | None = None) -> dict:
-    """Write table1.csv and fig2.png ... fig7.png; returns the rows and the paths."""
-    from ..plots import paper as figures
-
+def write_table1(out_dir, sols=None) -> tuple[list[dict], Path]:
+    """Table 1 from the analytic solutions, written to table1.csv; returns rows and path."""
     out = prepare_outdir(out_dir)
-    sols = solutions()
-    sims = simulated or {}
     rows = table1(sols)
-    paths = [write_csv(out / "table1.csv",
-                       ("case", "concentrated_or_slipping", "distributed_or_sticking", "total"),
-                       [[r[k] for r in rows] for k in ("case", "concentrated_or_slipping",
-                                                       "distributed_or_sticking", "total")],
-                       text_columns={"case"})]
-    for field, number, ylabel, title in FIGURES:
-        paths.append(figures.two_panel(field, number, ylabel, title, sols, sims,
-                                       Path(out) / f"fig{number}.png"))
-    paths.append(figures.fig7(sols, sims, Path(out) / "fig7.png"))
-    return {"table": rows, "paths": paths}
+    keys = ("case", "concentrated_or_slipping", "distributed_or_sticking", "total")
+    return rows, write_csv(out / "table1.csv", keys, [[r[k] for r in rows] for k in keys],
+                           text_columns={"case"})

@@ -1,0 +1,42 @@
+"""The registry of schemes, by name.
+
+A scheme is a class registered under its name (``numerics.integrator``): the
+numerics' validation, the convergence study's choices and the stability matrix all
+come from :func:`names`, :func:`get` and :func:`applicable`. Adding a scheme is one
+new module under ``beltsim/solvers`` that defines a
+:class:`~beltsim.solvers.base.Scheme` subclass decorated with :func:`register`, and
+one import line in ``beltsim/solvers/__init__.py``.
+"""
+
+from __future__ import annotations
+
+from ..errors import SceneError
+
+_REGISTRY: dict[str, type] = {}
+
+
+def register(cls):
+    """Class decorator: make a scheme available under ``cls.name``."""
+    _REGISTRY[cls.name] = cls
+    return cls
+
+
+def names() -> tuple[str, ...]:
+    return tuple(_REGISTRY)
+
+
+def get(name: str) -> type:
+    try:
+        return _REGISTRY[name]
+    except KeyError:
+        raise SceneError(f"numerics.integrator: must be one of "
+                         f"{' | '.join(repr(n) for n in _REGISTRY)}, got {name!r}") from None
+
+
+def applicable(name: str, inertia: bool) -> str | None:
+    """Why a scheme does not apply to a scene (None when it does)."""
+    cls = get(name)
+    if cls.needs_inertia and not inertia:
+        return (f'numerics.integrator: "{name}" needs physics.inertia = true (a quasistatic '
+                f'scene has no dynamics to step explicitly)')
+    return None
