@@ -289,7 +289,7 @@ def cmd_animate(args):
 
 
 def _int_list(text, name):
-    from .physics.grid import MIN_ELEMENTS
+    from .problem.scene import MIN_ELEMENTS
 
     try:
         vals = [int(v) for v in text.split(",")]

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SceneError
+from ..physics.model import traction
 from ..problem.scene import Scene
 from .files import OutputError, prepare_outdir, write_atomic, write_csv, write_json
 
@@ -54,8 +55,6 @@ def write_snapshots(path, result) -> Path:
     ``scene`` (the scene as TOML text). Single precision keeps a long run's file small
     and is far finer than a plot.
     """
-    from ..simulation.solution import traction
-
     sol, snaps = result.solution, result.snapshots
     buf = io.BytesIO()
     np.savez_compressed(buf, x=sol.x, t=snaps["t"], u=snaps["u"].astype(np.float32),

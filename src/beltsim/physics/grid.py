@@ -13,9 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SceneError
-
-#: The fewest elements of a grid: two in each of [0, x1], [x1, x2], [x2, L].
-MIN_ELEMENTS = 6
+from ..problem.scene import MIN_ELEMENTS
 
 
 @dataclass(frozen=True)

@@ -263,6 +263,16 @@ def block_solve(Lb, Db, Ub, r, x, C):
     return True
 
 
+def traction(fnode, he):
+    """Element traction f (N/m) at each node (of the element upstream), 0 off contact.
+
+    Works on stacks of states (last axis: nodes).
+    """
+    f = np.zeros_like(fnode)
+    f[..., 1:] = fnode[..., 1:] / he
+    return f
+
+
 # ---------------------------------------------------------------------------
 # numpy twins (tests, the bench's peer)
 

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import SceneError
-from ..physics.grid import MIN_ELEMENTS
 
 # ---------------------------------------------------------------------------
 # Schema
@@ -84,6 +83,8 @@ def _show(value):
 
 
 POS = _Rule("float", positive=True)
+#: The fewest elements of a grid: two in each of [0, x1], [x1, x2], [x2, L].
+MIN_ELEMENTS = 6
 
 #: Sections, their keys and rules. ``None`` in REQUIRED means optional section.
 SCHEMA: dict[str, dict[str, _Rule]] = {

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..physics.friction import saturation
 from ..physics.grid import Grid
+from ..physics.model import traction
 from ..problem.analytic import AnalyticSolution
 from ..problem.scene import Params
 
@@ -37,16 +38,6 @@ def nodal_slope(values, he):
 def stress_resultants(P: Params, u, theta, he) -> dict:
     """Tension b1 u_x and moment a theta_x at the nodes (works on stacks of states)."""
     return {"tension": P.b1 * nodal_slope(u, he), "moment": P.a * nodal_slope(theta, he)}
-
-
-def traction(fnode, he):
-    """Element traction f (N/m) at each node (of the element upstream), 0 off contact.
-
-    Works on stacks of states (last axis: nodes).
-    """
-    f = np.zeros_like(fnode)
-    f[..., 1:] = fnode[..., 1:] / he
-    return f
 
 
 def relative_error(value, exact) -> float:
