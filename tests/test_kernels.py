@@ -15,8 +15,11 @@ from beltsim.physics.friction import (
 )
 from beltsim.physics.grid import make_grid
 from beltsim.physics.model import (
+    Loads,
     State,
     assemble,
+    hermite_weights,
+    load_at,
     block_solve,
     blocks_to_dense,
     residual_numpy,
@@ -48,11 +51,18 @@ def _random_state(grid, seed, amp=1e-3):
     return u, th, State(uo, tho, zero.copy(), udo, tdo, zero.copy())
 
 
-def _assemble(d, u, th, lam, old, inv_dt, t, p):
+def _assemble(d, u, th, lam, old, inv_dt, t, p, loads=None):
     w = Workspace.allocate(d.grid.n_elements)
     fnode = np.zeros_like(u)
-    assemble(u, th, lam, fnode, old, inv_dt, t, d.mesh, p, d.drive, w, True)
+    assemble(u, th, lam, fnode, old, inv_dt, t, d.mesh, p, d.drive,
+             d.loads if loads is None else loads, w, True)
     return w, fnode
+
+
+def _random_loads(n, seed):
+    rng = np.random.default_rng(seed)
+    return Loads(np.array([0.0, 0.004, 0.01]),
+                 *(1e3 * rng.standard_normal((3, n)) for _ in range(4)))
 
 
 @pytest.mark.parametrize("law_name", ["tanh", "sqrt", "ramp"])
@@ -66,6 +76,24 @@ def test_residual_matches_numpy_twin(law_name, inertia):
     R, F = residual_numpy(u, th, old, 1e4, 0.005, d.mesh, p, d.drive)
     np.testing.assert_allclose(w.R, R, rtol=1e-12, atol=1e-9 * np.abs(R).max())
     np.testing.assert_allclose(fnode, F, rtol=1e-12, atol=1e-12)
+    loads = _random_loads(len(u), 7)
+    w, _ = _assemble(d, u, th, lam, old, 1e4, 0.005, p, loads)
+    R, _ = residual_numpy(u, th, old, 1e4, 0.005, d.mesh, p, d.drive, loads)
+    np.testing.assert_allclose(w.R, R, rtol=1e-12, atol=1e-9 * np.abs(R).max())
+
+
+def test_hermite_loads_interpolate_cubics_exactly():
+    """Cubic Hermite interpolation is exact for a cubic in time, and held outside."""
+    times = np.array([0.0, 0.3, 1.0])
+    q = lambda t: 2.0 - t + 3.0 * t**2 - 1.5 * t**3  # noqa: E731
+    dq = lambda t: -1.0 + 6.0 * t - 4.5 * t**2  # noqa: E731
+    table = np.array([[q(t)] for t in times]), np.array([[dq(t)] for t in times])
+    for t in (0.0, 0.1, 0.3, 0.77, 1.0):
+        k, *wts = hermite_weights(times, t)
+        got = load_at(table[0], table[1], k, *wts, 0)
+        assert got == pytest.approx(q(t), rel=1e-13)
+    k, *wts = hermite_weights(times, 5.0)
+    assert load_at(table[0], table[1], k, *wts, 0) == pytest.approx(q(1.0), rel=1e-13)
 
 
 @pytest.mark.parametrize("law_name", ["tanh", "sqrt"])
@@ -153,7 +181,7 @@ def test_dual_newton_solution_satisfies_primal_equations():
     w = Workspace.allocate(grid.n_elements)
     state, rest = d.new_state(), d.new_state()
     # a large step from rest at full surface speed: stick and slip nodes side by side
-    ok = newton(state, rest, 1.0 / 2e-3, 1.0, d.mesh, p, d.drive, d.scales,
+    ok = newton(state, rest, 1.0 / 2e-3, 1.0, d.mesh, p, d.drive, d.loads, d.scales,
                 NewtonSettings(1e-11, 60), w)
     assert ok
     R, F = residual_numpy(state.u, state.theta, rest, 1.0 / 2e-3, 1.0, d.mesh,

@@ -69,9 +69,9 @@ def test_requested_step_above_the_explicit_limit_is_refused():
 
 
 def test_explicit_without_damping_is_refused():
-    with pytest.raises(beltsim.SceneError, match=r"numerics\.damping"):
+    with pytest.raises(beltsim.SceneError, match=r"physics\.damping"):
         Simulation(_scene("paper_inertia", "numerics.integrator=explicit",
-                          "numerics.damping=0"))
+                          "physics.damping=0"))
 
 
 def test_explicit_limit_is_sharp():
@@ -82,12 +82,13 @@ def test_explicit_limit_is_sharp():
         sc = _scene("paper_inertia", "numerics.grading=1", "numerics.elements=200",
                     "motion.surface_speed=120")
         d = Discretisation(sc)
-        limit = explicit_stable_dt(d.params, d.grid.h_min, d.numerics.damping)
+        limit = explicit_stable_dt(d.params, d.grid.h_min, d.model.damping)
         state = d.new_state()
         rng = np.random.default_rng(0)
         state.u[1:-1] = 1e-6 * rng.standard_normal(len(state.u) - 2)
         state.theta[1:-1] = 1e-6 * rng.standard_normal(len(state.u) - 2)
-        advance_explicit(state, 0.0, 1.0, dt_factor * limit, 20000, d.mesh, d.model, d.drive)
+        advance_explicit(state, 0.0, 1.0, dt_factor * limit, 20000, d.mesh, d.model, d.drive,
+                         d.loads)
         return np.abs(state.u).max() / 1e-6
     assert run_with(0.95) < 10.0
     assert not run_with(1.3) < GROWTH_LIMIT  # overflowed or grew by > 1e4
@@ -104,7 +105,7 @@ def test_amplification_is_one_for_a_tiny_step_and_exceeds_one_beyond_cfl():
 def _explicit_step_numpy(u, th, v, w, dt, mesh, P, num):
     """Numpy twin of one explicit step (without the per-node scalar solver's shortcut)."""
     from scipy.optimize import brentq
-    c, hh, d = P.c, 0.5 * P.h, num.damping
+    c, hh, d = P.c, 0.5 * P.h, P.damping
     he, hb = mesh.he, mesh.hb
     m, mi = P.rho * hb, P.I * hb
     vn, wn = v.copy(), w.copy()
@@ -146,7 +147,7 @@ def test_explicit_step_matches_numpy_twin():
         a[[0, -1]] = 0.0
     ref = _explicit_step_numpy(u, th, v, w, dt, d.mesh, sc.params, sim.numerics)
     state = State(u.copy(), th.copy(), np.zeros(n), v.copy(), w.copy(), np.zeros(n))
-    advance_explicit(state, 0.0, 1e-30, dt, 1, d.mesh, d.model, d.drive)
+    advance_explicit(state, 0.0, 1e-30, dt, 1, d.mesh, d.model, d.drive, d.loads)
     got = (state.u, state.theta, state.ud, state.td, state.fnode)
     for got, want in zip(got, ref):
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12 * np.abs(want).max())

@@ -91,6 +91,58 @@ class State(NamedTuple):
             a[:] = b
 
 
+class Loads(NamedTuple):
+    """Distributed loads on the belt, tabulated in time: q_u (N/m) and q_theta (N m/m).
+
+    At the nodes, at ``times`` (K), with their time derivatives; cubic Hermite
+    interpolation in between (error O(dt_table^4)), held constant outside. They enter
+    the model as hbar_j q at node j. No times: no loads (the default; an API feature
+    for manufactured solutions and external excitation, not a scene key).
+    """
+
+    times: np.ndarray  # (K,)
+    qu: np.ndarray  # (K, N + 1)
+    qt: np.ndarray
+    dqu: np.ndarray  # d/dt of qu, qt
+    dqt: np.ndarray
+
+    @classmethod
+    def none(cls, n_nodes: int) -> "Loads":
+        empty = np.zeros((0, n_nodes))
+        return cls(np.zeros(0), empty, empty, empty, empty)
+
+
+@njit(cache=True)
+def hermite_weights(times, t):
+    """(k, w0, w1, v0, v1): q(t) = w0 q_k + w1 q_{k+1} + v0 q'_k + v1 q'_{k+1}; k = -1: none."""
+    K = times.shape[0]
+    if K == 0:
+        return -1, 0.0, 0.0, 0.0, 0.0
+    if K == 1 or t <= times[0]:
+        return 0, 1.0, 0.0, 0.0, 0.0
+    if t >= times[K - 1]:
+        return K - 2, 0.0, 1.0, 0.0, 0.0
+    lo, hi = 0, K - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if times[mid] <= t:
+            lo = mid
+        else:
+            hi = mid
+    dt = times[lo + 1] - times[lo]
+    s = (t - times[lo]) / dt
+    s2, s3 = s * s, s * s * s
+    return (lo, 2.0 * s3 - 3.0 * s2 + 1.0, -2.0 * s3 + 3.0 * s2, (s3 - 2.0 * s2 + s) * dt,
+            (s3 - s2) * dt)
+
+
+@njit(cache=True)
+def load_at(q, dq, k, w0, w1, v0, v1, j):
+    if k < 0:
+        return 0.0
+    return w0 * q[k, j] + w1 * q[k + 1, j] + v0 * dq[k, j] + v1 * dq[k + 1, j]
+
+
 def model_params(P, damping, friction_scale, v_reg, law_code) -> ModelParams:
     """The model's coefficients from the physical parameters and the friction settings."""
     # the linear law's dual and primal forms coincide; saturating laws need the dual
@@ -106,7 +158,7 @@ def mesh_of(grid) -> Mesh:
 
 
 @njit(cache=True)
-def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, w, want_jac):
+def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_jac):
     """Residual w.R (n, 2) of the interior nodes and, if want_jac, the Jacobian blocks.
 
     u, th, lam: trial values at t (N+1, boundary zeros); old: the State at the
@@ -128,6 +180,7 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, w, want_jac):
     uo, tho, udo, tdo = old.u, old.theta, old.ud, old.td
     R, Lb, Db, Ub, rl, sg = w.R, w.Lb, w.Db, w.Ub, w.rl, w.sg
     target = mismatch(drive, t)
+    lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
     code, dual = p.law, p.dual
     kin = inv_dt * inv_dt + damp * inv_dt  # d(acc + damp * vel)/dy
     for j in range(N + 1):
@@ -147,6 +200,9 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, w, want_jac):
               - B * ((u[j + 1] - u[j]) / hr - (u[j] - u[j - 1]) / hl))
         rt = (I * hbj * acc_t + I * c * (td_r - td_l)
               - A * ((th[j + 1] - th[j]) / hr - (th[j] - th[j - 1]) / hl) + b2 * hbj * th[j])
+        if lk >= 0:
+            ru -= hbj * load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j)
+            rt -= hbj * load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j)
         if want_jac:
             for a_ in range(2):
                 for b_ in range(2):
@@ -277,7 +333,7 @@ def traction(fnode, he):
 # numpy twins (tests, the bench's peer)
 
 
-def forces_numpy(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive):
+def forces_numpy(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, loads=None):
     """Nodal forces and moments of the semi-discrete model, all but the inertia terms.
 
     Returns (force on u, moment on theta) at the interior nodes and the nodal
@@ -298,14 +354,21 @@ def forces_numpy(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive):
           - p.damping * rho * hb[sl] * ud[sl] + F[sl])
     ft = (A * np.diff(np.diff(th) / he) - b2 * hb[sl] * th[sl] - I * c * (td[2:] - td[:-2])
           - p.damping * I * hb[sl] * td[sl] + hh * F[sl])
+    if loads is not None and len(loads.times):
+        k, *wts = hermite_weights(loads.times, t)
+        fu = fu + hb[sl] * (np.dot(wts, [loads.qu[k], loads.qu[k + 1], loads.dqu[k],
+                                          loads.dqu[k + 1]]))[sl]
+        ft = ft + hb[sl] * (np.dot(wts, [loads.qt[k], loads.qt[k + 1], loads.dqt[k],
+                                          loads.dqt[k + 1]]))[sl]
     return fu, ft, F
 
 
-def residual_numpy(u, th, old: State, inv_dt, t, mesh: Mesh, p: ModelParams, drive):
+def residual_numpy(u, th, old: State, inv_dt, t, mesh: Mesh, p: ModelParams, drive,
+                   loads=None):
     """Vectorised twin of :func:`assemble` (residual and nodal friction only)."""
     ud = (u - old.u) * inv_dt
     td = (th - old.theta) * inv_dt
-    fu, ft, F = forces_numpy(u, th, ud, td, t, mesh, p, drive)
+    fu, ft, F = forces_numpy(u, th, ud, td, t, mesh, p, drive, loads)
     sl, hb = slice(1, -1), mesh.hb
     ru = p.mass * hb[sl] * (ud[sl] - old.ud[sl]) * inv_dt - fu
     rt = p.rotary_inertia * hb[sl] * (td[sl] - old.td[sl]) * inv_dt - ft

@@ -104,7 +104,7 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "friction": _Rule("str", choices=("stick", "coulomb")),
         "max_friction": POS,
     },
-    "physics": {"inertia": _Rule("bool")},
+    "physics": {"inertia": _Rule("bool"), "damping": _Rule("float", nonneg=True)},
     "stiffness": {
         "bending": POS,
         "tension": POS,
@@ -122,7 +122,8 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "regularisation": POS,
         "friction_law": _Rule("str", choices=("tanh", "sqrt", "ramp")),
         "adhesion_layer": POS,
-        "damping": _Rule("float", nonneg=True),
+        "acceleration": _Rule("float", nonneg=True),
+        "time_tol": POS,
         "steady_tol": POS,
         "snapshot_interval": POS,
         "newton_tol": POS,
@@ -138,7 +139,19 @@ TOP_LEVEL_KEYS = ("title",)
 _ONLY_COULOMB = {("contact", "max_friction"), ("numerics", "regularisation"),
                  ("numerics", "friction_law")}
 _ONLY_STICK = {("numerics", "adhesion_layer")}
-_ONLY_INERTIA = {("stiffness", "mass"), ("stiffness", "rotary_inertia"), ("numerics", "damping")}
+# (physics.damping, like beam.density, describes the belt and is ignored without inertia)
+_ONLY_INERTIA = {("stiffness", "mass"), ("stiffness", "rotary_inertia"),
+                 ("numerics", "acceleration")}
+# Keys of required sections that may be left out (default in Params).
+_OPTIONAL_KEYS = {("physics", "damping")}
+# Keys that were, and what replaces them.
+_RETIRED = {
+    ("numerics", "damping"): (
+        "numerics.damping: removed, damping is physics now: set physics.damping (1/s, the "
+        "rate d of d rho u_t and d I theta_t), or, for a fast path to the steady state "
+        'whose transient does not matter, numerics.integrator = "pseudo" with '
+        "numerics.acceleration (1/s)"),
+}
 
 
 def validate(data: dict) -> dict:
@@ -171,6 +184,8 @@ def validate(data: dict) -> dict:
         clean = {}
         for key, value in table.items():
             name = f"{section}.{key}"
+            if (section, key) in _RETIRED:
+                raise SceneError(_RETIRED[section, key])
             if key not in rules:
                 raise SceneError(f"{name}: unknown key (known in [{section}]: "
                                  f"{', '.join(rules)})")
@@ -193,6 +208,8 @@ def validate(data: dict) -> dict:
                 continue
             if (section, key) == ("beam", "density") and inertia is False:
                 continue  # a quasistatic scene needs no density
+            if (section, key) in _OPTIONAL_KEYS:
+                continue
             raise SceneError(f"{name}: missing key")
 
     for section, key in _ONLY_COULOMB:
@@ -274,6 +291,7 @@ class Params:
     inertia: bool
     friction: str
     fstar: float | None
+    damping: float = 0.0  # d (1/s) of the viscous damping d rho u_t, d I theta_t
 
     @property
     def e0(self) -> float:
@@ -308,6 +326,7 @@ def _params(d: dict) -> Params:
         a=p["a"], b1=p["b1"], b2=p["b2"], rho=p["rho"], I=p["I"],
         inertia=d["physics"]["inertia"], friction=contact["friction"],
         fstar=contact.get("max_friction"),
+        damping=d["physics"].get("damping", 0.0) if d["physics"]["inertia"] else 0.0,
     )
 
 
@@ -430,6 +449,8 @@ def set_key(data: dict, key: str, value) -> None:
     section, name = key.split(".", 1)
     if section not in SCHEMA:
         raise SceneError(f"{key}: unknown section [{section}] (sections: {', '.join(SCHEMA)})")
+    if (section, name) in _RETIRED:
+        raise SceneError(_RETIRED[section, name])
     if name not in SCHEMA[section]:
         raise SceneError(f"{key}: unknown key (known in [{section}]: "
                          f"{', '.join(SCHEMA[section])})")

@@ -41,8 +41,10 @@ class Simulation:
     """
 
     def __init__(self, scene: Scene, grid: Grid | None = None,
-                 snapshot_interval: float | None = None):
+                 snapshot_interval: float | None = None, loads=None):
         self.disc = solvers.Discretisation(scene, grid)
+        if loads is not None:  # distributed loads (physics.model.Loads) on this grid
+            self.disc.loads = loads
         self.scheme = solvers.get(self.disc.numerics.integrator)(self.disc)
         self.state = self.disc.new_state()
         self.t = 0.0

@@ -3,16 +3,31 @@
 from __future__ import annotations
 
 import time
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 
 from ..physics.grid import Grid
-from ..physics.model import Mesh, ModelParams, State, mesh_of, model_params
+from ..physics.model import Loads, Mesh, ModelParams, State, mesh_of, model_params
 from ..problem.drive import Drive
 from ..problem.scene import Scene
-from .newton import Scales, scales_of
 from .settings import Numerics, build_grid, resolve
+
+
+class Scales(NamedTuple):
+    """Scales of the residual rows and of the unknowns (Newton norms, rates, growth)."""
+
+    force: float
+    moment: float
+    u: float
+    theta: float
+
+
+def scales_of(P) -> Scales:
+    """Force, moment, displacement and rotation scales of a scene's physical parameters."""
+    eps = abs(P.e0) if P.e0 != 0.0 else 1e-6
+    force = P.B * eps
+    return Scales(force, force * 0.5 * P.h, eps * P.L, eps)
 
 
 class Discretisation:
@@ -33,8 +48,10 @@ class Discretisation:
         self.numerics: Numerics = num
         self.grid: Grid = grid if grid is not None else build_grid(scene, num)
         self.mesh: Mesh = mesh_of(self.grid)
-        self.model: ModelParams = model_params(P, num.damping, num.fs, num.vreg, num.law_code)
+        self.model: ModelParams = model_params(P, P.damping + num.acceleration, num.fs, num.vreg,
+                                               num.law_code)
         self.drive = Drive(P.v - P.c, num.ramp_time)
+        self.loads: Loads = Loads.none(self.grid.n_elements + 1)
         self.scales: Scales = scales_of(P)
 
     def new_state(self) -> State:
@@ -52,6 +69,8 @@ class Scheme:
 
     name: ClassVar[str]
     transient: ClassVar[bool] = True
+    #: whether the path through time is the scene's (to a controlled error), not only the end
+    time_accurate: ClassVar[bool] = True
     needs_inertia: ClassVar[bool] = False
 
     def __init__(self, disc: Discretisation):

@@ -23,6 +23,7 @@ from numba import njit
 
 from ..errors import SceneError
 from ..physics.friction import LINEAR, RAMP, law
+from ..physics.model import hermite_weights, load_at
 from ..problem.drive import mismatch
 from .base import Scheme
 from .registry import register
@@ -75,7 +76,7 @@ def _friction_scalar(code, s_pred, kappa, s0):
 
 
 @njit(cache=True, fastmath=SAFE_FASTMATH)
-def advance_explicit(state, t, t_stop, dt, max_steps, mesh, p, drive):
+def advance_explicit(state, t, t_stop, dt, max_steps, mesh, p, drive, loads):
     """Explicit steps from t until t >= t_stop (or max_steps). Returns (t, steps).
 
     state.ud, state.td hold the local velocities v, w (half steps); state.lam each
@@ -125,6 +126,11 @@ def advance_explicit(state, t, t_stop, dt, max_steps, mesh, p, drive):
                      - al[j] * (u[j] - u[j - 1]))
             wn[j] = (keep * w[j] - gl[j] * (w[j] - w[j - 1]) + br[j] * (th[j + 1] - th[j])
                      - bl[j] * (th[j] - th[j - 1]) - spring * th[j])
+        lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
+        if lk >= 0:  # distributed loads at step n: dt hbar q / (rho hbar)
+            for j in range(1, N):
+                vn[j] += dt / rho * load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j)
+                wn[j] += dt / I * load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j)
         ub_l = u[j1] + hh * th[j1]
         for j in range(j1 + 1, j2 + 1):
             ub = u[j] + hh * th[j]
@@ -203,14 +209,14 @@ class ExplicitScheme(Scheme):
     def __init__(self, disc):
         super().__init__(disc)
         P, num, grid = disc.params, self.numerics, disc.grid
-        limit = explicit_stable_dt(P, grid.h_min, num.damping)
+        damping = disc.model.damping
+        limit = explicit_stable_dt(P, grid.h_min, damping)
         cfl = grid.h_min / (P.c + max(math.sqrt(P.b1 / P.rho), math.sqrt(P.a / P.I)))
         if limit < 0.05 * cfl:
             raise SceneError(
-                f"numerics.damping: the explicit scheme is unstable with damping = "
-                f"{num.damping:.6g} 1/s on this grid (its explicit gyroscopic term in the "
-                f"rotation equation needs damping); use the default damping or the implicit "
-                f"integrator")
+                f"physics.damping: the explicit scheme is unstable with damping = "
+                f"{damping:.6g} 1/s on this grid (its explicit gyroscopic term in the "
+                f"rotation equation needs damping); use the implicit integrator")
         requested = disc.scene.numerics.get("dt")
         if requested is not None and requested > limit:
             raise SceneError(
@@ -230,6 +236,6 @@ class ExplicitScheme(Scheme):
     def advance(self, state, t, t_stop, max_steps=10**9):
         d = self.disc
         t, steps = advance_explicit(state, t, t_stop, self.numerics.dt, max_steps, d.mesh,
-                                    d.model, d.drive)
+                                    d.model, d.drive, d.loads)
         self.steps += steps
         return t

@@ -1,144 +1,193 @@
-"""Implicit scheme: backward Euler on the discrete model, Newton at every step.
+"""Implicit scheme: variable-step BDF2, second order in time, with adaptive steps.
 
-A step whose Newton iteration fails is retried with a quarter of the time step;
-after a run of four successes the step grows back towards its nominal value. The
-same kernel serves inertial and quasistatic scenes: with rho = I = 0 the residual
-is algebraic except for the slip velocity, an index-1 DAE that backward Euler
-handles as is.
+The semi-discrete model is second order in time; BDF2 is applied to it as a first-
+order system in (u, v = u_t): with the step h_n and the ratio r = h_n / h_{n-1},
+
+    y'_{n+1} = a0 (y_{n+1} - y*),  a0 = (1 + 2r) / ((1 + r) h_n),
+    y* = ((1 + r)^2 y_n - r^2 y_{n-1}) / (1 + 2r)
+
+for y = u, theta (giving the velocities) and y = v, w (giving the accelerations).
+That is the residual of :func:`beltsim.physics.model.assemble` with ``inv_dt`` = a0
+and the previous state replaced by y*, so one Newton solve per step, as for backward
+Euler (which is the first step, with no history). BDF2 is A- and L-stable: the stiff
+friction relaxation and the unresolved high frequencies are damped, the resolved
+ones carry an error of order h^2. Zero-stability of the variable-step formula needs
+r < 1 + sqrt(2); the controller keeps r <= MAX_GROWTH.
+
+Local error: BDF2's leading term is (2/9) h^3 y''' at a constant step; u''' is
+estimated from the change of the computed acceleration over the step,
+h^2 |a_{n+1} - a_n| (for the first, backward-Euler step: h^2/2 |a_1 - a_0|). The
+step is accepted when its scaled max norm (u over e0 L, theta over e0) is below
+``time_tol`` and the next one is h (SAFETY time_tol / err)^(1/3), within
+[MIN_SHRINK, MAX_GROWTH] times the last. A rejected step or a failed Newton solve is
+retried with a smaller step. Steps end exactly at the controller's checks, so runs
+with different tolerances can be compared at the same times.
 """
 
 from __future__ import annotations
 
+import math
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
-from ..errors import NumericalError
 from ..physics.model import State
-from .base import Scheme
-from .newton import NewtonSettings, Workspace, newton
+from .newton import FAILED, NONFINITE, OK, NewtonScheme, newton
 from .registry import register
 
-# status codes of advance_implicit
-OK, FAILED, NONFINITE = 0, 1, 2
+SAFETY = 0.8
+MAX_GROWTH = 2.0  # largest ratio of successive steps (zero-stable below 1 + sqrt(2))
+MIN_SHRINK = 0.2
+BDF2_ERROR = 2.0 / 9.0  # leading error constant of BDF2 at a constant step
+NEWTON_CUT = 0.25  # step factor after a failed Newton solve
+
+
+class History(NamedTuple):
+    """What BDF2 keeps of the past: the previous step's state and the accelerations now."""
+
+    u: np.ndarray  # u, theta, u_t, theta_t at t_{n-1}
+    theta: np.ndarray
+    ud: np.ndarray
+    td: np.ndarray
+    au: np.ndarray  # u_tt, theta_tt at t_n
+    at: np.ndarray
+
+    @classmethod
+    def zeros(cls, n_nodes):
+        return cls(*(np.zeros(n_nodes) for _ in cls._fields))
 
 
 @njit(cache=True)
-def advance_implicit(state, old, t, t_stop, dt, dt_nominal, max_steps, mesh, p, drive, scales,
-                     settings, w):
-    """Backward-Euler steps from t until t >= t_stop (or max_steps).
+def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol, max_steps,
+                 mesh, p, drive, loads, scales, settings, w):
+    """Adaptive BDF2 steps from t until t_stop (reached exactly) or max_steps.
 
-    Updates ``state`` in place; ``old`` is workspace for the previous step. Returns
-    (status, t, dt, steps).
+    ``state`` holds u, theta, the friction unknowns and u_t, theta_t at t; ``hist``
+    the previous step (h_prev = 0: there is none, the next step is backward Euler);
+    ``base`` is workspace for y*. Returns (status, t, h_prev, h_next, steps, rejected).
     """
     u, th, lam, ud, td = state.u, state.theta, state.lam, state.ud, state.td
-    uo, tho, udo, tdo, lamo = old.u, old.theta, old.ud, old.td, old.lam
     N = u.shape[0] - 1
     steps = 0
-    good = 0
-    dt_min = dt_nominal * 1e-7
-    while t < t_stop and steps < max_steps:
+    rejected = 0
+    u_n = np.empty(N + 1)
+    th_n = np.empty(N + 1)
+    ud_n = np.empty(N + 1)
+    td_n = np.empty(N + 1)
+    lam_n = np.empty(N + 1)
+    au_new = np.empty(N + 1)
+    at_new = np.empty(N + 1)
+    while t < t_stop * (1.0 - 1e-14) and steps < max_steps:
+        remaining = t_stop - t
+        # steps that end on t_stop: the remaining span in equal parts of at most h_next
+        h = remaining / math.ceil(remaining / min(h_next, h_max) * (1.0 - 1e-12))
         for j in range(N + 1):
-            uo[j] = u[j]
-            tho[j] = th[j]
-            udo[j] = ud[j]
-            tdo[j] = td[j]
-            lamo[j] = lam[j]
-        h = dt
-        inv = 1.0 / h
-        # predictor: constant local velocity over the step
-        for j in range(1, N):
-            u[j] = uo[j] + h * udo[j]
-            th[j] = tho[j] + h * tdo[j]
-        ok = newton(state, old, inv, t + h, mesh, p, drive, scales, settings, w)
-        if ok:
-            finite = True
+            u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j] = u[j], th[j], ud[j], td[j], lam[j]
+        if h_prev > 0.0:
+            r = h / h_prev
+            a0 = (1.0 + 2.0 * r) / ((1.0 + r) * h)
+            cn = (1.0 + r) * (1.0 + r) / (1.0 + 2.0 * r)
+            cp = r * r / (1.0 + 2.0 * r)
             for j in range(N + 1):
-                ud[j] = (u[j] - uo[j]) * inv
-                td[j] = (th[j] - tho[j]) * inv
+                base.u[j] = cn * u_n[j] - cp * hist.u[j]
+                base.theta[j] = cn * th_n[j] - cp * hist.theta[j]
+                base.ud[j] = cn * ud_n[j] - cp * hist.ud[j]
+                base.td[j] = cn * td_n[j] - cp * hist.td[j]
+            err_const = BDF2_ERROR
+        else:
+            a0 = 1.0 / h
+            for j in range(N + 1):
+                base.u[j], base.theta[j] = u_n[j], th_n[j]
+                base.ud[j], base.td[j] = ud_n[j], td_n[j]
+            err_const = 0.5
+        # predictor: second-order Taylor step with the current accelerations
+        for j in range(1, N):
+            u[j] = u_n[j] + h * ud_n[j] + 0.5 * h * h * hist.au[j]
+            th[j] = th_n[j] + h * td_n[j] + 0.5 * h * h * hist.at[j]
+        ok = newton(state, base, a0, t + h, mesh, p, drive, loads, scales, settings, w)
+        err = 0.0
+        finite = True
+        if ok:
+            for j in range(N + 1):
+                ud[j] = a0 * (u[j] - base.u[j])
+                td[j] = a0 * (th[j] - base.theta[j])
+                au_new[j] = a0 * (ud[j] - base.ud[j])
+                at_new[j] = a0 * (td[j] - base.td[j])
                 if not (np.isfinite(u[j]) and np.isfinite(th[j])):
                     finite = False
-            if not finite:
-                for j in range(N + 1):
-                    u[j], th[j], ud[j], td[j], lam[j] = uo[j], tho[j], udo[j], tdo[j], lamo[j]
-                return NONFINITE, t, dt, steps
+                eu = abs(au_new[j] - hist.au[j]) / scales.u
+                et = abs(at_new[j] - hist.at[j]) / scales.theta
+                if eu > err:
+                    err = eu
+                if et > err:
+                    err = et
+            err *= err_const * h * h
+        if ok and not finite:
+            for j in range(N + 1):
+                u[j], th[j], ud[j], td[j], lam[j] = u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j]
+            return NONFINITE, t, h_prev, h_next, steps, rejected
+        if ok and err <= tol:
+            for j in range(N + 1):
+                hist.u[j], hist.theta[j] = u_n[j], th_n[j]
+                hist.ud[j], hist.td[j] = ud_n[j], td_n[j]
+                hist.au[j], hist.at[j] = au_new[j], at_new[j]
             t += h
             steps += 1
-            good += 1
-            if good >= 4 and dt < dt_nominal:
-                dt = min(2.0 * dt, dt_nominal)
-                good = 0
+            h_prev = h
+            factor = MAX_GROWTH if err == 0.0 else SAFETY * (tol / err) ** (1.0 / 3.0)
+            h_next = h * min(MAX_GROWTH, max(MIN_SHRINK, factor))
+            continue
+        # rejected: back to t_n with a smaller step
+        rejected += 1
+        w.stats[0].failed_steps += 1
+        for j in range(N + 1):
+            u[j], th[j], ud[j], td[j], lam[j] = u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j]
+        if ok:
+            h_next = h * max(MIN_SHRINK, SAFETY * (tol / err) ** (1.0 / 3.0))
         else:
-            w.stats[0].failed_steps += 1
-            for j in range(N + 1):
-                u[j], th[j], ud[j], td[j], lam[j] = uo[j], tho[j], udo[j], tdo[j], lamo[j]
-            dt *= 0.25
-            good = 0
-            if dt < dt_min:
-                return FAILED, t, dt, steps
-    return OK, t, dt, steps
-
-
-class NewtonScheme(Scheme):
-    """The workspace, Newton settings and counters of the schemes that solve with Newton."""
-
-    def __init__(self, disc):
-        super().__init__(disc)
-        num = self.numerics
-        self.work = Workspace.allocate(disc.grid.n_elements)
-        self.settings = NewtonSettings(num.newton_tol, num.newton_max_it)
-        # the previous step's state (with inv_dt = 0, the steady equations ignore it)
-        self.old = disc.new_state()
-
-    def statistics(self) -> dict:
-        st = self.work.stats[0]
-        return {"steps": self.steps, "newton_iterations": int(st["newton_iterations"]),
-                "rejected_steps": int(st["failed_steps"]),
-                "line_search_cuts": int(st["line_search_cuts"])}
-
-    def checkpoint(self) -> dict:
-        return {**super().checkpoint(), "stats": self.work.stats.copy()}
-
-    def restore(self, data: dict) -> None:
-        super().restore(data)
-        self.work.stats[:] = data["stats"]
+            h_next = h * NEWTON_CUT
+        if h_next < h_min:
+            return FAILED, t, h_prev, h_next, steps, rejected
+    return OK, t, h_prev, h_next, steps, rejected
 
 
 @register
 class ImplicitScheme(NewtonScheme):
-    """Backward Euler with step cutting on Newton failure."""
+    """Variable-step BDF2 with local error control: the time-accurate default."""
 
     name = "implicit"
 
     def __init__(self, disc):
         super().__init__(disc)
-        self._dt = self.numerics.dt
+        n = disc.grid.n_elements + 1
+        self.hist = History.zeros(n)
+        self.h_prev = 0.0  # no previous step: the first is backward Euler
+        self.h_next = self.numerics.dt
 
     @property
     def dt(self) -> float:
-        return self._dt
+        return self.h_next
 
     def _compile(self, state: State) -> None:
         self.advance(state, 0.0, 0.0, max_steps=0)
 
     def advance(self, state, t, t_stop, max_steps=10**9):
-        d = self.disc
-        status, t, dt, steps = advance_implicit(
-            state, self.old, t, t_stop, self._dt, self.numerics.dt, max_steps, d.mesh, d.model,
-            d.drive, d.scales, self.settings, self.work)
-        self._dt, self.steps = dt, self.steps + steps
-        if status == FAILED:
-            raise NumericalError(
-                f"Newton iteration failed at t = {t:.6g} s even with the step cut to "
-                f"dt = {dt:.3g} s (residual norm {self.work.stats[0]['merit']:.3g})", t=t,
-                quantity="newton")
-        if status == NONFINITE:
-            raise NumericalError(f"non-finite displacement or rotation at t = {t:.6g} s",
-                                 t=t, quantity="u/theta")
+        d, num = self.disc, self.numerics
+        status, t, self.h_prev, self.h_next, steps, _ = advance_bdf2(
+            state, self.hist, self.old, t, t_stop, self.h_prev, self.h_next, num.dt * 1e-7,
+            t_stop - t if t_stop > t else num.dt, num.time_tol, max_steps, d.mesh, d.model,
+            d.drive, d.loads, d.scales, self.settings, self.work)
+        self.steps += steps
+        self.check_status(status, t, self.h_next)
         return t
 
     def checkpoint(self) -> dict:
-        return {**super().checkpoint(), "dt": np.array(self._dt)}
+        return {**super().checkpoint(), "h": np.array([self.h_prev, self.h_next]),
+                **{f"hist_{k}": a.copy() for k, a in zip(History._fields, self.hist)}}
 
     def restore(self, data: dict) -> None:
         super().restore(data)
-        self._dt = float(data["dt"])
+        self.h_prev, self.h_next = (float(v) for v in data["h"])
+        for k, a in zip(History._fields, self.hist):
+            a[:] = data[f"hist_{k}"]

@@ -15,8 +15,12 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from ..errors import NumericalError
 from ..physics.model import assemble, block_solve, update_multipliers
+from .base import Scheme
 
+# status codes of the time-stepping kernels that solve with Newton
+OK, FAILED, NONFINITE = 0, 1, 2
 # How far above the tolerance a stalled Newton update may be and still count as
 # converged: 1e3 * 1e-9 = 1e-6, an order below the discretisation error of the finest
 # grid tried (1.4e-5 on 20,000 elements).
@@ -25,15 +29,6 @@ ROUNDOFF_FLOOR = 1e3
 #: Counters a scheme accumulates, one record the kernels update in place.
 STATS_DTYPE = np.dtype([("newton_iterations", np.int64), ("failed_steps", np.int64),
                         ("line_search_cuts", np.int64), ("merit", np.float64)])
-
-
-class Scales(NamedTuple):
-    """Scales of the residual rows and of the unknowns (Newton norms, rates, growth)."""
-
-    force: float
-    moment: float
-    u: float
-    theta: float
 
 
 class NewtonSettings(NamedTuple):
@@ -65,13 +60,6 @@ class Workspace(NamedTuple):
                    sg=np.zeros(N + 1), stats=np.zeros(1, STATS_DTYPE))
 
 
-def scales_of(P) -> Scales:
-    """Force, moment, displacement and rotation scales of a scene's physical parameters."""
-    eps = abs(P.e0) if P.e0 != 0.0 else 1e-6
-    force = P.B * eps
-    return Scales(force, force * 0.5 * P.h, eps * P.L, eps)
-
-
 @njit(cache=True)
 def merit(R, scales):
     m = 0.0
@@ -83,7 +71,7 @@ def merit(R, scales):
 
 
 @njit(cache=True)
-def newton(state, old, inv_dt, t, mesh, p, drive, scales, settings, w):
+def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     """Solve the step's residual for (u, theta, lam) of ``state`` in place, from their values.
 
     Converged when the update is below settings.tol (scaled max norm; absolute for
@@ -97,7 +85,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, scales, settings, w):
     st = w.stats[0]
     tol = settings.tol
     n = R.shape[0]
-    assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, w, True)
+    assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
     m0 = merit(R, scales)
     if m0 == 0.0:
         return True
@@ -121,7 +109,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, scales, settings, w):
             for i in range(n):
                 u[i + 1] += dx[i, 0]
                 th[i + 1] += dx[i, 1]
-            assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, w, True)
+            assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
             st.merit = merit(R, scales)
             update = max(step, dlam)
             if update < tol or (update < ROUNDOFF_FLOOR * tol and update > 0.5 * previous):
@@ -135,7 +123,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, scales, settings, w):
             for i in range(n):
                 u_try[i + 1] = u[i + 1] + alpha * dx[i, 0]
                 th_try[i + 1] = th[i + 1] + alpha * dx[i, 1]
-            assemble(u_try, th_try, lam, fnode, old, inv_dt, t, mesh, p, drive, w, True)
+            assemble(u_try, th_try, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
             m = merit(R, scales)
             if m <= (1.0 - 1e-4 * alpha) * m0:
                 accepted = True
@@ -144,7 +132,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, scales, settings, w):
             st.line_search_cuts += 1
         if not accepted:
             # no decrease possible: fine if already at round-off, else a failure
-            assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, w, True)
+            assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
             st.merit = m0
             return step < ROUNDOFF_FLOOR * tol
         for i in range(n):
@@ -155,3 +143,39 @@ def newton(state, old, inv_dt, t, mesh, p, drive, scales, settings, w):
         if alpha * step < tol or m < 1e-30:
             return True
     return False
+
+
+class NewtonScheme(Scheme):
+    """The workspace, Newton settings and counters of the schemes that solve with Newton."""
+
+    def __init__(self, disc):
+        super().__init__(disc)
+        num = self.numerics
+        self.work = Workspace.allocate(disc.grid.n_elements)
+        self.settings = NewtonSettings(num.newton_tol, num.newton_max_it)
+        # the previous step's state (with inv_dt = 0, the steady equations ignore it)
+        self.old = disc.new_state()
+
+    def statistics(self) -> dict:
+        st = self.work.stats[0]
+        return {"steps": self.steps, "newton_iterations": int(st["newton_iterations"]),
+                "rejected_steps": int(st["failed_steps"]),
+                "line_search_cuts": int(st["line_search_cuts"])}
+
+    def checkpoint(self) -> dict:
+        return {**super().checkpoint(), "stats": self.work.stats.copy()}
+
+    def restore(self, data: dict) -> None:
+        super().restore(data)
+        self.work.stats[:] = data["stats"]
+
+    def check_status(self, status, t, dt) -> None:
+        """Raise NumericalError for a kernel's FAILED or NONFINITE status."""
+        if status == FAILED:
+            raise NumericalError(
+                f"Newton iteration failed at t = {t:.6g} s even with the step cut to "
+                f"dt = {dt:.3g} s (residual norm {self.work.stats[0]['merit']:.3g})", t=t,
+                quantity="newton")
+        if status == NONFINITE:
+            raise NumericalError(f"non-finite displacement or rotation at t = {t:.6g} s",
+                                 t=t, quantity="u/theta")

@@ -10,8 +10,7 @@ from __future__ import annotations
 
 from ..errors import NumericalError
 from ..problem.drive import Drive
-from .implicit import NewtonScheme
-from .newton import NewtonSettings, newton
+from .newton import NewtonScheme, NewtonSettings, newton
 from .registry import register
 
 MIN_STAGE = 1e-6  # smallest continuation stage, relative to the full mismatch
@@ -24,12 +23,13 @@ class SteadyScheme(NewtonScheme):
 
     name = "steady"
     transient = False
+    time_accurate = False
 
     def _stage(self, state, s, settings):
         d = self.disc
         drive = Drive(d.drive.mismatch * s, 0.0)
-        return newton(state, self.old, 0.0, 0.0, d.mesh, d.model, drive, d.scales, settings,
-                      self.work)
+        return newton(state, self.old, 0.0, 0.0, d.mesh, d.model, drive, d.loads, d.scales,
+                      settings, self.work)
 
     def _compile(self, state) -> None:
         trial = state.copy()
