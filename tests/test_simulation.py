@@ -123,10 +123,11 @@ def test_equal_speeds_give_the_zero_state():
 
 
 def test_steady_state_does_not_depend_on_damping_or_step():
-    """Trap 3: damping on local time derivatives leaves the steady state unchanged."""
+    """Trap 3: damping on local time derivatives leaves the steady state unchanged, the
+    scene's own (physics.damping) and the pseudo-transient's acceleration alike."""
     a = _run("paper_slip", "numerics.elements=250")
-    b = _run("paper_slip", "numerics.elements=250", "numerics.damping=3000",
-             "numerics.dt=1e-4")
+    b = _run("paper_slip", "numerics.elements=250", "physics.damping=3000",
+             "numerics.integrator=pseudo", "numerics.acceleration=1000", "numerics.dt=1e-4")
     # both stop at steady_tol = 1e-6 relative change per window
     assert b.solution.total_friction == pytest.approx(a.solution.total_friction, rel=2e-5)
     scale = np.abs(a.solution.u).max()

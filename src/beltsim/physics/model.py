@@ -329,6 +329,55 @@ def traction(fnode, he):
     return f
 
 
+# Power balance of the semi-discrete model. Multiplying the equations of motion by the
+# local velocities, the skew gyroscopic term drops out and
+#     dE/dt = P_surface + P_transport + P_loads - D_slip - D_damping
+# with E = 1/2 sum hbar (rho u_t^2 + I theta_t^2) + 1/2 (B sum (du)^2/h + A sum (dtheta)^2/h
+# + b2 sum hbar theta^2) (B, A: the effective stiffnesses of the moving belt), and, with
+# the nodal friction F_j and u_b = u + (h/2) theta, sum F_j d/dt u_b,j split along
+# v_rel = d/dt u_b + c d/dx u_b - (v(t) - c): the slip dissipation D_slip = -sum F v_rel
+# (>= 0), the surface's power P_surface = (v(t) - c) sum F, and the transport part
+# P_transport = -c sum F d/dx u_b (the strain carried through the contact).
+POWER_TERMS = ("surface", "transport", "loads", "slip", "damping")
+
+
+@njit(cache=True)
+def power_terms(state, t, mesh, p, drive, loads, out):
+    """The five power terms of POWER_TERMS (W) of a state at time t, into ``out``."""
+    u, th, ud, td, F = state.u, state.theta, state.ud, state.td, state.fnode
+    he, hb, hh, c = mesh.he, mesh.hb, p.half_height, p.speed
+    target = mismatch(drive, t)
+    surface = 0.0
+    transport = 0.0
+    slip = 0.0
+    for j in range(mesh.j1 + 1, mesh.j2 + 1):
+        strain_b = (u[j] + hh * th[j] - u[j - 1] - hh * th[j - 1]) / he[j - 1]
+        vrel = ud[j] + hh * td[j] + c * strain_b - target
+        surface += target * F[j]
+        transport -= c * F[j] * strain_b
+        slip -= F[j] * vrel
+    damping = 0.0
+    load = 0.0
+    lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
+    for j in range(1, u.shape[0] - 1):
+        damping += p.damping * hb[j] * (p.mass * ud[j] * ud[j]
+                                        + p.rotary_inertia * td[j] * td[j])
+        if lk >= 0:
+            load += hb[j] * (load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j) * ud[j]
+                             + load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j) * td[j])
+    out[0], out[1], out[2], out[3], out[4] = surface, transport, load, slip, damping
+
+
+def stored_energy(state, mesh: Mesh, p: ModelParams) -> float:
+    """Kinetic plus elastic energy E of the power balance (J)."""
+    hb, he = mesh.hb, mesh.he
+    kinetic = 0.5 * np.sum(hb * (p.mass * state.ud**2 + p.rotary_inertia * state.td**2))
+    elastic = 0.5 * (p.tension_eff * np.sum(np.diff(state.u) ** 2 / he)
+                     + p.bending_eff * np.sum(np.diff(state.theta) ** 2 / he)
+                     + p.shear * np.sum(hb * state.theta**2))
+    return float(kinetic + elastic)
+
+
 # ---------------------------------------------------------------------------
 # numpy twins (tests, the bench's peer)
 

@@ -24,6 +24,7 @@ from .trackers import (
     CheckpointTracker,
     DivergenceGuard,
     HistoryTracker,
+    PowerBalanceTracker,
     ProgressTracker,
     SignalTracker,
     SnapshotTracker,
@@ -55,11 +56,12 @@ class Simulation:
         self.check = window / CHECKS_PER_TRANSIT
         if self.snapshot_interval:
             self.check = min(self.check, self.snapshot_interval)
-        self.history = HistoryTracker()
+        self.history = HistoryTracker("stick" if self.params.friction == "stick" else "slip")
         self.steady = SteadyStateTracker(num.steady_tol, window, num.ramp_time,
                                          P.B * self.disc.scales.theta * 1e-3)
         self.snapshots = (SnapshotTracker(self.snapshot_interval) if self.snapshot_interval
                           else None)
+        self.power = PowerBalanceTracker() if hasattr(self.scheme, "work_integrals") else None
         self._measured = None
 
     # views ------------------------------------------------------------
@@ -118,6 +120,8 @@ class Simulation:
                  checkpoint=None) -> list[Tracker]:
         """The trackers of a run, in the order they handle each check."""
         out: list[Tracker] = [DivergenceGuard(), self.history]
+        if self.power is not None:
+            out.append(self.power)
         if self.snapshots is not None:
             out.append(self.snapshots)
         if progress:
@@ -202,15 +206,19 @@ class Simulation:
     def _result(self, status, reason, compile_time) -> RunResult:
         return RunResult(
             scene=self.scene, numerics=self.numerics, status=status, reason=reason,
+            time_accurate=self.scheme.time_accurate,
             solution=self.solution(), simulated_time=self.t, wall_time=self.wall_time,
             compile_time=compile_time, statistics=self.scheme.statistics(),
             history=self.history.arrays(),
+            power_balance=self.power.balance(self) if self.power is not None else None,
             snapshots=self.snapshots.arrays() if self.snapshots is not None else {})
 
     # checkpoints ------------------------------------------------------
     def tracker_states(self) -> dict:
         """The state of every tracker a resumed run continues with, by name."""
         out = {"history": self.history.state(), "steady": self.steady.state()}
+        if self.power is not None:
+            out["power"] = self.power.state()
         if self.snapshots is not None:
             out["snapshots"] = self.snapshots.state()
         return out
@@ -231,6 +239,8 @@ class Simulation:
         sim.steady.restore(trackers["steady"])
         if sim.snapshots is not None:
             sim.snapshots.restore(trackers["snapshots"])
+        if sim.power is not None:
+            sim.power.restore(trackers["power"])
         return sim
 
 

@@ -24,6 +24,7 @@ class RunResult:
     numerics: Numerics
     status: RunStatus
     reason: str | None
+    time_accurate: bool  # the scheme follows the scene's path, not only its end
     solution: DiscreteSolution
     simulated_time: float
     wall_time: float
@@ -31,6 +32,8 @@ class RunResult:
     statistics: dict
     history: dict
     snapshots: dict = field(default_factory=dict)
+    #: E(t) - E(0) against the integrated power terms (schemes that integrate them)
+    power_balance: dict | None = None
     #: the exact steady solution of the same scene, attached by the caller (None: not
     #: attached, or the scene has none)
     reference: analytic.AnalyticSolution | None = None
@@ -63,9 +66,12 @@ class RunResult:
     def summary(self) -> dict:
         out = self.solution.summary()
         out.update(converged=self.converged, simulated_time=self.simulated_time,
-                   steps=self.steps, wall_time=self.wall_time, compile_time=self.compile_time,
+                   steps=self.steps, rejected_steps=self.statistics.get("rejected_steps", 0),
+                   time_accurate=self.time_accurate, wall_time=self.wall_time,
+                   compile_time=self.compile_time,
                    reason=self.reason, elements=self.numerics.elements,
-                   integrator=self.numerics.integrator, error=self.errors())
+                   integrator=self.numerics.integrator, power_balance=self.power_balance,
+                   error=self.errors())
         return out
 
 

@@ -67,28 +67,38 @@ class DivergenceGuard(Tracker):
 
 
 class HistoryTracker(Tracker):
-    """t, total friction and the largest local rate at every check."""
+    """At every check: t, total friction, the largest local rate, and the friction split.
+
+    Coulomb scenes add the slip start and the stick and slip parts of the friction,
+    perfect adhesion the concentrated force, read off the state as in the summary.
+    """
 
     name = "history"
-    KEYS = ("t", "total_friction", "rate")
+    BASE = ("t", "total_friction", "rate")
+    SPLIT = {"slip": ("slip_start", "stick_friction", "slip_friction"),
+             "stick": ("concentrated_force",)}
 
-    def __init__(self):
-        self.data = {k: [] for k in self.KEYS}
+    def __init__(self, model: str):
+        self.keys = self.BASE + self.SPLIT[model]
+        self.data = {k: [] for k in self.keys}
 
     def handle(self, sim):
+        summary = sim.solution().summary()
         self.data["t"].append(sim.t)
-        self.data["total_friction"].append(sim.total_friction())
         self.data["rate"].append(sim.rate())
+        for k in self.keys:
+            if k not in ("t", "rate"):
+                self.data[k].append(summary[k])
         return None
 
     def arrays(self) -> dict:
         return {k: np.array(v) for k, v in self.data.items()}
 
     def state(self):
-        return {"rows": np.array([self.data[k] for k in self.KEYS])}
+        return {"rows": np.array([self.data[k] for k in self.keys])}
 
     def restore(self, data):
-        for k, row in zip(self.KEYS, data["rows"]):
+        for k, row in zip(self.keys, data["rows"]):
             self.data[k] = list(row)
 
 
@@ -186,6 +196,43 @@ class SnapshotTracker(Tracker):
         self.times = list(data["t"])
         for k in self.KEYS:
             self.fields[k] = list(data[k])
+
+
+class PowerBalanceTracker(Tracker):
+    """The power balance over the run, for schemes that integrate the power terms.
+
+    E(t) - E(0) = W_surface + W_transport + W_loads - D_slip - D_damping
+    (physics.model.POWER_TERMS); the residual, relative to the dissipated energy
+    D_slip + D_damping, measures how well the time integration keeps it.
+    """
+
+    name = "power"
+
+    def __init__(self):
+        self.initial_energy = None
+
+    def initialize(self, sim):
+        from ..physics.model import stored_energy
+        if self.initial_energy is None:
+            self.initial_energy = stored_energy(sim.state, sim.disc.mesh, sim.disc.model)
+
+    def balance(self, sim) -> dict:
+        from ..physics.model import stored_energy
+        work = sim.scheme.work_integrals()
+        change = stored_energy(sim.state, sim.disc.mesh, sim.disc.model) - self.initial_energy
+        dissipated = work["slip"] + work["damping"]
+        residual = change - (work["surface"] + work["transport"] + work["loads"] - dissipated)
+        return {"stored_energy_change": change, "surface_work": work["surface"],
+                "transport_work": work["transport"], "load_work": work["loads"],
+                "slip_dissipation": work["slip"], "damping_dissipation": work["damping"],
+                "residual": residual,
+                "relative_residual": abs(residual) / dissipated if dissipated > 0 else None}
+
+    def state(self):
+        return {"initial_energy": np.array(self.initial_energy)}
+
+    def restore(self, data):
+        self.initial_energy = float(data["initial_energy"])
 
 
 class ProgressTracker(Tracker):

@@ -16,10 +16,15 @@ r < 1 + sqrt(2); the controller keeps r <= MAX_GROWTH.
 
 Local error: BDF2's leading term is (2/9) h^3 y''' at a constant step; u''' is
 estimated from the change of the computed acceleration over the step,
-h^2 |a_{n+1} - a_n| (for the first, backward-Euler step: h^2/2 |a_1 - a_0|). The
-step is accepted when its scaled max norm (u over e0 L, theta over e0) is below
-``time_tol`` and the next one is h (SAFETY time_tol / err)^(1/3), within
-[MIN_SHRINK, MAX_GROWTH] times the last. A rejected step or a failed Newton solve is
+e = (2/9) h^2 (a_{n+1} - a_n) (for the first, backward-Euler step: h^2/2 (a_1 - a_0)).
+Raw, that estimate is large for stiff components (high-frequency modes, the friction
+relaxation) that BDF2 damps and need not follow: it is filtered as in Hairer and
+Wanner's Radau code, solving J e_f = T e with the step's Newton matrix J and its
+time-derivative part T (a0^2 M + a0 (d M + G + friction)), so resolved components
+(J ~ T) keep their estimate and stiff ones (J >> T) drop out. The step is accepted
+when the scaled max norm of e_f (u over e0 L, theta over e0) is below ``time_tol``;
+the next one is h (SAFETY time_tol / err)^(1/3), within [MIN_SHRINK, MAX_GROWTH]
+times the last. A rejected step or a failed Newton solve is
 retried with a smaller step. Steps end exactly at the controller's checks, so runs
 with different tolerances can be compared at the same times.
 """
@@ -32,7 +37,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..physics.model import State
+from ..physics.model import POWER_TERMS, State, block_solve, power_terms
 from .newton import FAILED, NONFINITE, OK, NewtonScheme, newton
 from .registry import register
 
@@ -41,6 +46,7 @@ MAX_GROWTH = 2.0  # largest ratio of successive steps (zero-stable below 1 + sqr
 MIN_SHRINK = 0.2
 BDF2_ERROR = 2.0 / 9.0  # leading error constant of BDF2 at a constant step
 NEWTON_CUT = 0.25  # step factor after a failed Newton solve
+FILTER = True
 
 
 class History(NamedTuple):
@@ -59,13 +65,39 @@ class History(NamedTuple):
 
 
 @njit(cache=True)
+def filtered_error(e, a0, mesh, p, w, out):
+    """Solve J e_f = T e in place of ``e`` (n, 2); J: w's blocks, T: their a0 part."""
+    n = e.shape[0]
+    rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
+    kin = a0 * a0 + p.damping * a0
+    he, hb = mesh.he, mesh.hb
+    for i in range(n):
+        j = i + 1
+        ul = e[i - 1, 0] if i > 0 else 0.0
+        ur = e[i + 1, 0] if i < n - 1 else 0.0
+        tl = e[i - 1, 1] if i > 0 else 0.0
+        tr = e[i + 1, 1] if i < n - 1 else 0.0
+        out[i, 0] = kin * rho * hb[j] * e[i, 0] + a0 * rho * c * (ur - ul)
+        out[i, 1] = kin * I * hb[j] * e[i, 1] + a0 * I * c * (tr - tl)
+        if mesh.j1 < j <= mesh.j2:
+            k = he[j - 1] * p.friction_scale * w.sg[j] / p.v_reg * a0
+            eb = e[i, 0] + hh * e[i, 1]
+            out[i, 0] += k * eb
+            out[i, 1] += hh * k * eb
+    return block_solve(w.Lb, w.Db, w.Ub, out, e, w.C)
+
+
+@njit(cache=True)
 def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol, max_steps,
-                 mesh, p, drive, loads, scales, settings, w):
+                 mesh, p, drive, loads, scales, settings, w, power, work):
     """Adaptive BDF2 steps from t until t_stop (reached exactly) or max_steps.
 
     ``state`` holds u, theta, the friction unknowns and u_t, theta_t at t; ``hist``
     the previous step (h_prev = 0: there is none, the next step is backward Euler);
-    ``base`` is workspace for y*. Returns (status, t, h_prev, h_next, steps, rejected).
+    ``base`` is workspace for y*; ``power`` holds the power terms at t
+    (physics.model.POWER_TERMS) and ``work`` accumulates their integrals over the
+    accepted steps (trapezoidal rule, second order like the scheme). Returns
+    (status, t, h_prev, h_next, steps, rejected).
     """
     u, th, lam, ud, td = state.u, state.theta, state.lam, state.ud, state.td
     N = u.shape[0] - 1
@@ -78,10 +110,14 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
     lam_n = np.empty(N + 1)
     au_new = np.empty(N + 1)
     at_new = np.empty(N + 1)
-    while t < t_stop * (1.0 - 1e-14) and steps < max_steps:
+    p_new = np.empty(power.shape[0])
+    e = np.empty((N - 1, 2))
+    te = np.empty((N - 1, 2))
+    while t < t_stop and steps < max_steps:
         remaining = t_stop - t
         # steps that end on t_stop: the remaining span in equal parts of at most h_next
-        h = remaining / math.ceil(remaining / min(h_next, h_max) * (1.0 - 1e-12))
+        parts = math.ceil(remaining / min(h_next, h_max) * (1.0 - 1e-12))
+        h = remaining / parts
         for j in range(N + 1):
             u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j] = u[j], th[j], ud[j], td[j], lam[j]
         if h_prev > 0.0:
@@ -116,13 +152,14 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
                 at_new[j] = a0 * (td[j] - base.td[j])
                 if not (np.isfinite(u[j]) and np.isfinite(th[j])):
                     finite = False
-                eu = abs(au_new[j] - hist.au[j]) / scales.u
-                et = abs(at_new[j] - hist.at[j]) / scales.theta
-                if eu > err:
-                    err = eu
-                if et > err:
-                    err = et
-            err *= err_const * h * h
+            for i in range(N - 1):
+                e[i, 0] = err_const * h * h * (au_new[i + 1] - hist.au[i + 1])
+                e[i, 1] = err_const * h * h * (at_new[i + 1] - hist.at[i + 1])
+            if FILTER and filtered_error(e, a0, mesh, p, w, te) or not FILTER:
+                for i in range(N - 1):
+                    err = max(err, abs(e[i, 0]) / scales.u, abs(e[i, 1]) / scales.theta)
+            else:
+                err = np.inf
         if ok and not finite:
             for j in range(N + 1):
                 u[j], th[j], ud[j], td[j], lam[j] = u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j]
@@ -132,9 +169,13 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
                 hist.u[j], hist.theta[j] = u_n[j], th_n[j]
                 hist.ud[j], hist.td[j] = ud_n[j], td_n[j]
                 hist.au[j], hist.at[j] = au_new[j], at_new[j]
-            t += h
+            t = t_stop if parts == 1 else t + h  # the last part lands on t_stop exactly
             steps += 1
             h_prev = h
+            power_terms(state, t, mesh, p, drive, loads, p_new)
+            for k in range(power.shape[0]):
+                work[k] += 0.5 * h * (power[k] + p_new[k])
+                power[k] = p_new[k]
             factor = MAX_GROWTH if err == 0.0 else SAFETY * (tol / err) ** (1.0 / 3.0)
             h_next = h * min(MAX_GROWTH, max(MIN_SHRINK, factor))
             continue
@@ -164,6 +205,8 @@ class ImplicitScheme(NewtonScheme):
         self.hist = History.zeros(n)
         self.h_prev = 0.0  # no previous step: the first is backward Euler
         self.h_next = self.numerics.dt
+        self.power = np.zeros(len(POWER_TERMS))  # at the current time
+        self.work_done = np.zeros(len(POWER_TERMS))  # integrals since the start
 
     @property
     def dt(self) -> float:
@@ -177,17 +220,23 @@ class ImplicitScheme(NewtonScheme):
         status, t, self.h_prev, self.h_next, steps, _ = advance_bdf2(
             state, self.hist, self.old, t, t_stop, self.h_prev, self.h_next, num.dt * 1e-7,
             t_stop - t if t_stop > t else num.dt, num.time_tol, max_steps, d.mesh, d.model,
-            d.drive, d.loads, d.scales, self.settings, self.work)
+            d.drive, d.loads, d.scales, self.settings, self.work, self.power, self.work_done)
         self.steps += steps
         self.check_status(status, t, self.h_next)
         return t
 
+    def work_integrals(self) -> dict:
+        """The time integrals (J) of the power terms since the start of the run."""
+        return dict(zip(POWER_TERMS, (float(v) for v in self.work_done)))
+
     def checkpoint(self) -> dict:
         return {**super().checkpoint(), "h": np.array([self.h_prev, self.h_next]),
+                "power": self.power.copy(), "work_done": self.work_done.copy(),
                 **{f"hist_{k}": a.copy() for k, a in zip(History._fields, self.hist)}}
 
     def restore(self, data: dict) -> None:
         super().restore(data)
         self.h_prev, self.h_next = (float(v) for v in data["h"])
+        self.power[:], self.work_done[:] = data["power"], data["work_done"]
         for k, a in zip(History._fields, self.hist):
             a[:] = data[f"hist_{k}"]
