@@ -45,3 +45,12 @@ def test_missing_snapshots_is_a_clean_error(tmp_path):
     proc = cli("animate", "--from", str(tmp_path))
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1
     assert "snapshots.npz" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_every_frame_names_the_scheme_and_the_damping():
+    from beltsim.plots.animate import scheme_label
+    from beltsim.problem.scene import load_scene
+    default = scheme_label(load_scene(scene_path("paper_slip")))
+    assert default == "implicit (time-accurate), damping 39 1/s"
+    pseudo = scheme_label(load_scene(scene_path("paper_slip"), ["numerics.integrator=pseudo"]))
+    assert pseudo.startswith("pseudo (pseudo-transient path)") and "acceleration" in pseudo

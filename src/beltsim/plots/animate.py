@@ -37,6 +37,20 @@ def frame_fields(snaps: dict) -> dict:
             "theta": th, "u": u}
 
 
+def scheme_label(scene) -> str:
+    """The scheme and the damping a transient was computed with, for every frame."""
+    from .. import solvers
+
+    name = scene.numerics.get("integrator", "implicit")
+    kind = "time-accurate" if solvers.get(name).time_accurate else "pseudo-transient path"
+    damping = scene.params.damping
+    text = f"{name} ({kind}), damping {damping:g} 1/s" if scene.params.inertia else (
+        f"{name} ({kind}), quasistatic")
+    if "acceleration" in scene.numerics or name == "pseudo":
+        text += " + numerical acceleration"
+    return text
+
+
 def _limits(values, exact):
     lo = min(np.nanmin(values), np.nanmin(exact))
     hi = max(np.nanmax(values), np.nanmax(exact))
@@ -97,6 +111,7 @@ def animate(snapshots_path, out_path, fmt: str = "gif", fps: int = 15) -> Path:
             ax.legend(loc="upper left", fontsize=8, bbox_to_anchor=(0.0, 0.82))
     axes[-1].set_xlabel("x [m]")
     stamp = axes[0].set_title("", fontsize=10)
+    how = scheme_label(scene)
     fig.suptitle(scene.title or "beltsim transient", fontsize=11)
 
     def draw(k):
@@ -105,7 +120,7 @@ def animate(snapshots_path, out_path, fmt: str = "gif", fps: int = 15) -> Path:
         f = fields["friction"][k]
         off = np.abs(f) > f_cap
         marks.set_data(x[off], np.sign(f[off]) * f_cap * 0.97)
-        stamp.set_text(f"t = {1e3 * times[k]:.2f} ms")
+        stamp.set_text(f"t = {1e3 * times[k]:.2f} ms   {how}")
         return [*lines.values(), marks, stamp]
 
     out_path = Path(out_path)

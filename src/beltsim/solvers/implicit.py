@@ -115,6 +115,9 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
     te = np.empty((N - 1, 2))
     while t < t_stop and steps < max_steps:
         remaining = t_stop - t
+        if remaining <= 1e-9 * h_next:  # round-off of the caller's times, not a step
+            t = t_stop
+            break
         # steps that end on t_stop: the remaining span in equal parts of at most h_next
         parts = math.ceil(remaining / min(h_next, h_max) * (1.0 - 1e-12))
         h = remaining / parts
