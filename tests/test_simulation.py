@@ -159,7 +159,12 @@ def test_cli_run_writes_outputs(tmp_path):
     assert list(fields) == ["x", "u", "theta", "strain", "tension", "moment", "friction"]
     assert np.all(np.isfinite(np.column_stack(list(fields.values()))))
     hist = read_csv(out / "history.csv")
-    assert list(hist) == ["t", "total_friction", "rate"] and len(hist["t"]) > 3
+    assert list(hist) == ["t", "total_friction", "rate", "slip_start", "stick_friction",
+                          "slip_friction"] and len(hist["t"]) > 3
+    # the split adds up, and the slip start lies in the contact
+    np.testing.assert_allclose(hist["stick_friction"] + hist["slip_friction"],
+                               hist["total_friction"], rtol=1e-12, atol=1e-9)
+    assert np.all((hist["slip_start"] >= 1 / 3 - 1e-12) & (hist["slip_start"] <= 2 / 3 + 1e-12))
     assert (out / "scene.toml").exists()
 
 

@@ -16,9 +16,10 @@ def test_convergence_command_small_ladder(tmp_path):
     assert proc.returncode == 0, proc.stderr
     table = read_csv_text(tmp_path / "convergence.csv")
     assert [r["scheme"] for r in table] == (["explicit"] * 3 + ["implicit"] * 3
-                                             + ["steady"] * 3 + ["richardson"] * 3)
+                                             + ["pseudo"] * 3 + ["steady"] * 3
+                                             + ["richardson"] * 3)
     assert all(float(r["converged"]) == 1.0 for r in table)  # booleans as numbers
-    for scheme in ("explicit", "implicit", "steady"):
+    for scheme in ("explicit", "implicit", "pseudo", "steady"):
         errs = [float(r["error_total_friction"]) for r in table if r["scheme"] == scheme]
         assert errs[0] > errs[1] > errs[2]  # refining shrinks the error
         assert all(float(r["wall_time"]) > 0 for r in table if r["scheme"] == scheme)

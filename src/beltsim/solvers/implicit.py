@@ -37,7 +37,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..physics.model import POWER_TERMS, State, block_solve, power_terms
+from ..physics.model import POWER_TERMS, block_solve, power_terms
 from .newton import FAILED, NONFINITE, OK, NewtonScheme, newton
 from .registry import register
 
@@ -214,9 +214,6 @@ class ImplicitScheme(NewtonScheme):
     @property
     def dt(self) -> float:
         return self.h_next
-
-    def _compile(self, state: State) -> None:
-        self.advance(state, 0.0, 0.0, max_steps=0)
 
     def advance(self, state, t, t_stop, max_steps=10**9):
         d, num = self.disc, self.numerics

@@ -14,7 +14,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..physics.model import State
 from .newton import FAILED, NONFINITE, OK, NewtonScheme, newton
 from .registry import register
 
@@ -89,9 +88,6 @@ class PseudoScheme(NewtonScheme):
     @property
     def dt(self) -> float:
         return self._dt
-
-    def _compile(self, state: State) -> None:
-        self.advance(state, 0.0, 0.0, max_steps=0)
 
     def advance(self, state, t, t_stop, max_steps=10**9):
         d = self.disc
