@@ -1,28 +1,76 @@
-"""Explicit scheme (inertial scenes): staggered leapfrog.
+"""Explicit scheme (inertial scenes): second order in time, stable without damping.
 
-u, theta at whole steps, their local velocities v, w at half steps. Elastic, shear
-and damping forces use the state at step n; the gyroscopic term 2 c u_xt is upwind
-in space, explicit in time (central in space it grows at any step: the explicit
-skew term has |amplification| = sqrt(1 + (g dt)^2)); at steady state it vanishes,
-so the steady state is the implicit scheme's. Friction is implicit in the node's
-own velocity (one monotone scalar equation per contact node), so its stiffness
-f*/v_reg sets no step limit; the transport part of the slip velocity uses step n
-and obeys the CFL condition of the waves.
+Each step is a Strang splitting of the semi-discrete model into two parts:
 
-The step is EXPLICIT_SAFETY of the limit found by a von Neumann analysis of the
-scheme on the smallest element; a requested step above the limit is refused.
+* the velocity terms (gyroscopic 2 c u_xt and damping d u_t), advanced over dt by the
+  trapezoidal rule together with the drift u' = v: the midpoint velocity
+  vm = (v_a + v_b) / 2 solves (2/dt + d) vm + G vm = (2/dt) v_a, with G the
+  gyroscopic operator over the lumped mass (lower bidiagonal, one pass in the
+  direction of the flow for both fields), then v_b = 2 vm - v_a and u += dt vm. The
+  trapezoidal rule is A-stable, so G sets no step limit, damping or not (explicit, the
+  central G grows at any step and the upwind one needs damping in the rotation
+  equation);
+* the kick at t_n: elastic, shear, load and friction forces of u_n, v += dt f / m.
+  The half kicks of consecutive Strang steps merge into this one, so between steps
+  the state is (u_n, v after the kick), and u_t(t_n) is the mean of the velocities
+  before and after it (second order).
+
+Only the kick's stiffness terms are explicit: the step is limited by the waves
+(dt <= h / sqrt(B / rho) on a uniform grid; the old leapfrog needed
+h / (c + sqrt(b1 / rho))). Both parts vanish at rest, so the fixed point is the
+semi-discrete steady state of the implicit schemes.
+
+G is upwind, 2 rho c hbar_j (v_j - v_{j-1}) / h_{j-1} (the old scheme's form), where
+the implicit schemes have the central rho c (v_{j+1} - v_{j-1}). Both vanish at
+steady state, so the steady state is shared; the transients differ at O(h), the
+order of the discretisation as a whole. Measured on the linearisation of the
+semi-discrete model at the paper slip steady state (default grid): with the central
+term it is unstable, real parts up to +2.5/s with d = 39/s and +9/s with d = 0
+(friction in the stick zone pumps the rotation modes), and a time-accurate scheme
+follows it and never settles (BDF2 at time_tol 1e-7 had not settled after 3 s on 300
+elements; the default implicit run settles through BDF2's damping at its large
+steps). With the upwind term the slowest mode decays at 10/s with d = 39/s; with
+d = 0 it decays on coarse grids (4.8/s on 300 elements), while on the default grid
+one mode still grows at +0.28/s, which a run reproduces (within 5% of the steady
+friction up to t_end). The central term, by a tridiagonal (Thomas) solve, was also
+stable by von Neumann but grew near its limit on bounded grids without damping.
+
+Friction is implicit in each contact node's own velocity. Its slope f* / v_reg is
+enormous, so the velocity it sees must damp the friction relaxation (the mean of the
+velocities before and after the kick, trapezoidal, rings with amplification -1 and,
+with the transport term, diverges in stick) yet be second order (the velocity after
+the kick, backward Euler, is first order). The slip velocity of node j is taken as
+
+    b_before + A_EST delta_j - C_EST delta_j^{n-1}
+    + (c / h) [(ub_j + ALPHA dt delta_j) - (ub_{j-1} + ALPHA dt delta_{j-1})] - (v - c)
+
+with b = u_t + (h/2) theta_t the bottom-fibre velocity, delta its kick increment (this
+step's, and the previous step's for C_EST) and A_EST - C_EST = 1/2 (consistency). The
+corrections are dt times changes of increments: O(dt^2) where friction is smooth,
+zero at steady state. C_EST = 1/16 puts the roots of the stiff limit at -1/3 (a
+double root, the smallest reachable); ALPHA makes the stick-zone transport (upwind,
+explicit in u_n) stable at any Courant number c dt / h (without it the stiff limit
+needs c dt / h < 0.25, below the waves' limit). delta_{j-1} is known first in a
+sweep in the direction of the flow, so each node is one monotone scalar equation.
+
+The step is EXPLICIT_SAFETY of the limit found by a von Neumann analysis of this
+scheme (both fields, friction at all slopes with its transport) on the smallest
+element; a requested step above the limit is refused.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+from functools import lru_cache
+from types import SimpleNamespace
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from ..errors import SceneError
-from ..physics.friction import LINEAR, RAMP, law
+from ..physics.friction import LINEAR, RAMP, SQRT, TANH, law
 from ..physics.model import hermite_weights, load_at
 from ..problem.drive import mismatch
 from .base import Scheme
@@ -32,6 +80,27 @@ EXPLICIT_SAFETY = 0.9  # default explicit step as a fraction of the stability li
 SMALL_STEP = 1e-5  # relative Newton step below which the friction solve stops
 # fast-math flags that keep NaN and inf semantics (a failing run must still show them)
 SAFE_FASTMATH = {"reassoc", "contract", "arcp"}
+# friction's velocity estimate (module notes): consistency needs A_EST - C_EST = 1/2
+C_EST = 1.0 / 16.0
+A_EST = 0.5 + C_EST
+ALPHA = 0.25
+# friction slopes of the von Neumann analysis, as dt k (1/rho + (h/2)^2 / I): the
+# relaxation of the bottom-fibre velocity per step, from none (sliding) to stick
+FRICTION_Z = np.concatenate([[0.0], np.logspace(-3.0, 9.0, 17)])
+# amplification accepted as 1: eigenvalues on the unit circle carry round-off
+TOL = 1e-9
+
+
+class History(NamedTuple):
+    """What the scheme carries from step to step besides the State."""
+
+    va: np.ndarray  # u_t, theta_t after the last kick (N + 1)
+    wa: np.ndarray
+    db: np.ndarray  # the last kick's bottom-fibre increments (contact nodes)
+
+    @classmethod
+    def zeros(cls, n_nodes):
+        return cls(*(np.zeros(n_nodes) for _ in cls._fields))
 
 
 @njit(cache=True)
@@ -41,6 +110,9 @@ def _friction_scalar(code, s_pred, kappa, s0):
     g is odd, increasing and |g| <= 1 (unless linear), so the root lies in
     [s_pred - kappa, s_pred + kappa]. Newton from s0 (the node's value at the previous
     step, so one or two iterations in a settled state), safeguarded by bisection.
+    A sliding node's root lies at the edge of that interval, to round-off: s0 is
+    clamped into it, not replaced, and a converged step may end on the edge (strict
+    bounds sent a third of the steps of sliding nodes to bisection, 10-20 iterations).
     """
     if code == LINEAR:  # closed form
         s = s_pred / (1.0 + kappa)
@@ -51,16 +123,18 @@ def _friction_scalar(code, s_pred, kappa, s0):
             return s, s
         return (s_pred - kappa, 1.0) if s_pred > 0 else (s_pred + kappa, -1.0)
     lo, hi = s_pred - kappa, s_pred + kappa
-    s = s0 if lo < s0 < hi else s_pred / (1.0 + kappa)
+    s = min(max(s0, lo), hi)
     tol = 1e-13 * (abs(s_pred) + kappa)
-    g = 0.0
-    for _ in range(80):
+    edge = 1e-15 * (abs(s_pred) + kappa)  # round-off of lo and hi
+    last_step = hi - lo
+    for _ in range(100):
         g, gp = law(code, s)
         r = s + kappa * g - s_pred
         ds = -r / (1.0 + kappa * gp)
-        if abs(ds) <= SMALL_STEP * (1.0 + abs(s)) and lo < s + ds < hi:
+        if abs(ds) <= SMALL_STEP * (1.0 + abs(s)) and lo - edge <= s + ds <= hi + edge:
             # g linearised over the step: error g'' ds^2 / 2 < 1e-10, and none at a
             # fixed point; in a settled run this is the first iteration (ds ~ 1e-7)
+            ds = min(max(s + ds, lo), hi) - s
             return s + ds, g + gp * ds
         if abs(r) <= tol:
             return s, g
@@ -68,140 +142,346 @@ def _friction_scalar(code, s_pred, kappa, s0):
             hi = s
         else:
             lo = s
-        s_new = s + ds
-        if not (lo < s_new < hi):
-            s_new = 0.5 * (lo + hi)
-        s = s_new
-    return s, g
+        # bisection when Newton leaves the bracket or stops halving its steps (it can
+        # cycle across the inflection at s = 0 when it starts far out)
+        if not (lo < s + ds < hi) or abs(ds) > 0.5 * last_step:
+            ds = 0.5 * (lo + hi) - s
+        last_step = abs(ds)
+        s += ds
+    return s, law(code, s)[0]
+
+
+class Coefficients(NamedTuple):
+    """Per-node coefficients of one step (precomputed for a step size)."""
+
+    P: np.ndarray  # the velocity system solved: vm_j = P_j v_a,j + Ql_j vm_{j-1}
+    Ql: np.ndarray
+    ar: np.ndarray  # dt B / (m_j h_j), dt B / (m_j h_{j-1}): the axial kick
+    al: np.ndarray
+    br: np.ndarray  # the same for the bending term
+    bl: np.ndarray
+    fm: np.ndarray  # contact nodes: dt / m_j, dt (h/2) / m_I,j: a nodal force's kick
+    fi: np.ndarray
+    kb: np.ndarray  # fm + (h/2) fi: the bottom-fibre kick of a unit force
+    ch: np.ndarray  # c / h_{j-1}
+    tr: np.ndarray  # ALPHA c dt / h_{j-1}
+    fh: np.ndarray  # h_{j-1} f_s
+    kap: np.ndarray  # (A_EST + tr) kb fh / v_reg: the scalar friction equation's kappa
+
+
+@njit(cache=True)
+def coefficients(dt, mesh, p):
+    """The Coefficients of steps of size dt (once per advance, O(N))."""
+    N = mesh.he.shape[0]
+    he, hb = mesh.he, mesh.hb
+    rho, rot, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
+    z = np.zeros
+    co = Coefficients(z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1),
+                      z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1))
+    for j in range(1, N):
+        m, mi = rho * hb[j], rot * hb[j]
+        # row j of (2/dt + d + G) vm = (2/dt) v_a over the lumped mass, with
+        # G v_j = g_j (v_j - v_{j-1}), g_j = 2 c / h_{j-1}
+        g = 2.0 * c / he[j - 1]
+        piv = 2.0 / dt + p.damping + g
+        co.P[j] = (2.0 / dt) / piv
+        co.Ql[j] = g / piv
+        co.ar[j] = dt * p.tension_eff / (m * he[j])
+        co.al[j] = dt * p.tension_eff / (m * he[j - 1])
+        co.br[j] = dt * p.bending_eff / (mi * he[j])
+        co.bl[j] = dt * p.bending_eff / (mi * he[j - 1])
+        co.fm[j] = dt / m
+        co.fi[j] = dt * hh / mi
+        co.kb[j] = co.fm[j] + hh * co.fi[j]
+        co.ch[j] = c / he[j - 1]
+        co.tr[j] = ALPHA * c * dt / he[j - 1]
+        co.fh[j] = he[j - 1] * p.friction_scale
+        co.kap[j] = (A_EST + co.tr[j]) * co.kb[j] * co.fh[j] / p.v_reg
+    return co
 
 
 @njit(cache=True, fastmath=SAFE_FASTMATH)
-def advance_explicit(state, t, t_stop, dt, max_steps, mesh, p, drive, loads):
-    """Explicit steps from t until t >= t_stop (or max_steps). Returns (t, steps).
+def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, co, mesh, p):
+    """The kick's friction at the contact nodes, in the direction of the flow.
 
-    state.ud, state.td hold the local velocities v, w (half steps); state.lam each
-    contact node's last friction argument v_rel / v_reg, the warm start of its
-    scalar solve. The wave, shear, gyroscopic and damping update is one branch-free
-    pass over precomputed coefficients into new velocity buffers; friction then
-    corrects the contact nodes.
+    On entry va, wa hold the kick without friction, bb the bottom-fibre velocity
+    before the kick and eb its increment without friction; db the previous kick's
+    bottom increments, replaced by this kick's.
     """
-    u, th, v, w, sfr, fnode = state.u, state.theta, state.ud, state.td, state.lam, state.fnode
+    j1, j2, hh, code, ivreg = mesh.j1, mesh.j2, p.half_height, p.law, 1.0 / p.v_reg
+    smooth = code == TANH or code == SQRT
+    ub_l = u[j1] + hh * th[j1]
+    db_l = eb[j1]  # x1's node has no friction
+    for j in range(j1 + 1, j2 + 1):
+        ub = u[j] + hh * th[j]
+        tr = co.tr[j]
+        known = (bb[j] + (A_EST + tr) * eb[j] - C_EST * db[j] + co.ch[j] * (ub - ub_l)
+                 - tr * db_l - target)
+        # the first Newton iteration of _friction_scalar, written out and evaluated
+        # at the warm start s0 before the slip velocity is known: the sweep's chain
+        # from node to node is then a few multiplications, while the law's exp and
+        # the divisions of successive nodes overlap. It converges in ~95% of the
+        # node-steps; the rest, and an s0 outside the bracket, go to the full solve.
+        s0, kap = sfr[j], co.kap[j]
+        if code == TANH:
+            e = math.exp(-2.0 * abs(s0))
+            g0 = math.copysign((1.0 - e) / (1.0 + e), s0)
+            gp = 1.0 - g0 * g0
+        elif code == SQRT:
+            q = 1.0 / math.sqrt(1.0 + s0 * s0)
+            g0, gp = s0 * q, q * q * q
+        else:
+            g0, gp = 0.0, 0.0
+        inv = 1.0 / (1.0 + kap * gp)
+        sp = known * ivreg
+        ds = (sp - s0 - kap * g0) * inv
+        edge = 1e-15 * (abs(sp) + kap)
+        if (smooth and abs(s0 - sp) <= kap and abs(ds) <= SMALL_STEP * (1.0 + abs(s0))
+                and abs(s0 + ds - sp) <= kap + edge):
+            ds = min(max(s0 + ds, sp - kap), sp + kap) - s0
+            s, g = s0 + ds, g0 + gp * ds
+        else:
+            s, g = _friction_scalar(code, sp, kap, s0)
+        F = -co.fh[j] * g
+        va[j] += co.fm[j] * F
+        wa[j] += co.fi[j] * F
+        d = eb[j] + co.kb[j] * F
+        db[j] = d
+        db_l = d
+        ub_l = ub
+        sfr[j] = s
+        fnode[j] = F
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH)
+def _add_loads(va, wa, eb, t, dt, p, loads):
+    """The kick of the distributed loads at t: dt hbar q / (rho hbar)."""
+    lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
+    if lk < 0:
+        return
+    hh = p.half_height
+    su, st = dt / p.mass, dt / p.rotary_inertia
+    for j in range(1, va.shape[0] - 1):
+        du = su * load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j)
+        dw = st * load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j)
+        va[j] += du
+        wa[j] += dw
+        eb[j] += du + hh * dw
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH)
+def _kick_from(u, th, va, wa, vb, wb, bb, eb, co, spring, hh):
+    """The kick without friction and loads from the velocities vb, wb (a fresh start)."""
+    for k in range(1, u.shape[0] - 1):
+        eu = co.ar[k] * (u[k + 1] - u[k]) - co.al[k] * (u[k] - u[k - 1])
+        et = (co.br[k] * (th[k + 1] - th[k]) - co.bl[k] * (th[k] - th[k - 1])
+              - spring * th[k])
+        bb[k] = vb[k] + hh * wb[k]
+        eb[k] = eu + hh * et
+        va[k] = vb[k] + eu
+        wa[k] = wb[k] + et
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH)
+def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, drive, loads):
+    """Steps from t until t >= t_stop (or max_steps). Returns (t, steps).
+
+    ``hist`` holds the velocities after the last kick and its bottom-fibre increments;
+    with ``fresh`` they are first rebuilt from the state (u, theta, u_t, theta_t at t)
+    by two kicks at t, the second from the velocities half a kick before u_t, so a
+    start from any state is second order. On return state.ud, state.td hold u_t,
+    theta_t at t (the mean of the velocities before and after the last kick),
+    state.fnode that kick's friction and state.lam each contact node's v_rel / v_reg
+    (the warm start of its scalar solve).
+    """
+    u, th, sfr, fnode, ud, td = state.u, state.theta, state.lam, state.fnode, state.ud, state.td
+    va, wa, db = hist.va, hist.wa, hist.db
     N = u.shape[0] - 1
-    B, A, b2 = p.tension_eff, p.bending_eff, p.shear
-    rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
-    damp, fs, vreg = p.damping, p.friction_scale, p.v_reg
-    code, j1, j2, he, hb = p.law, mesh.j1, mesh.j2, mesh.he, mesh.hb
-    ar = np.zeros(N + 1)
-    al = np.zeros(N + 1)
-    br = np.zeros(N + 1)
-    bl = np.zeros(N + 1)
-    gl = np.zeros(N + 1)
-    kap = np.zeros(N + 1)
-    fm = np.zeros(N + 1)
-    fi = np.zeros(N + 1)
-    ch = np.zeros(N + 1)
-    fh = np.zeros(N + 1)
-    ivreg = 1.0 / vreg
-    for j in range(1, N):
-        m, mi = rho * hb[j], I * hb[j]
-        ar[j] = dt * B / (m * he[j])
-        al[j] = dt * B / (m * he[j - 1])
-        br[j] = dt * A / (mi * he[j])
-        bl[j] = dt * A / (mi * he[j - 1])
-        gl[j] = 2.0 * c * dt / he[j - 1]  # upwind gyroscopic term
-        fm[j] = dt / m
-        fi[j] = dt * hh / mi
-        kap[j] = dt * he[j - 1] * fs * (1.0 / m + hh * hh / mi) / vreg
-        ch[j] = c / he[j - 1]
-        fh[j] = he[j - 1] * fs
-    keep = 1.0 - dt * damp
-    spring = dt * b2 / I
-    vn = v.copy()
-    wn = w.copy()
+    hh = p.half_height
+    spring = dt * p.shear / p.rotary_inertia
+    co = coefficients(dt, mesh, p)
+    P, Ql, ar, al, br, bl = co.P, co.Ql, co.ar, co.al, co.br, co.bl
+    bb = np.zeros(N + 1)
+    eb = np.zeros(N + 1)
+    yv = np.zeros(N + 1)  # a fresh start's velocities before the kick
+    yw = np.zeros(N + 1)
+    if fresh:
+        for j in range(N + 1):
+            fnode[j] = 0.0
+            db[j] = 0.0
+        target = mismatch(drive, t)
+        for rep in range(2):
+            _kick_from(u, th, va, wa, yv if rep else ud, yw if rep else td, bb, eb, co,
+                       spring, hh)
+            _add_loads(va, wa, eb, t, dt, p, loads)
+            _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, co, mesh, p)
+            for j in range(1, N):  # u_t - delta / 2
+                yv[j] = 1.5 * ud[j] - 0.5 * va[j]
+                yw[j] = 1.5 * td[j] - 0.5 * wa[j]
     steps = 0
     while t < t_stop and steps < max_steps:
-        target = mismatch(drive, t + 0.5 * dt)
-        for j in range(1, N):
-            vn[j] = (keep * v[j] - gl[j] * (v[j] - v[j - 1]) + ar[j] * (u[j + 1] - u[j])
-                     - al[j] * (u[j] - u[j - 1]))
-            wn[j] = (keep * w[j] - gl[j] * (w[j] - w[j - 1]) + br[j] * (th[j + 1] - th[j])
-                     - bl[j] * (th[j] - th[j - 1]) - spring * th[j])
-        lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
-        if lk >= 0:  # distributed loads at step n: dt hbar q / (rho hbar)
-            for j in range(1, N):
-                vn[j] += dt / rho * load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j)
-                wn[j] += dt / I * load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j)
-        ub_l = u[j1] + hh * th[j1]
-        for j in range(j1 + 1, j2 + 1):
-            ub = u[j] + hh * th[j]
-            s_pred = (vn[j] + hh * wn[j] + ch[j] * (ub - ub_l) - target) * ivreg
-            ub_l = ub
-            sj, g = _friction_scalar(code, s_pred, kap[j], sfr[j])
-            sfr[j] = sj
-            F = -fh[j] * g
-            fnode[j] = F
-            vn[j] += fm[j] * F
-            wn[j] += fi[j] * F
-        for j in range(1, N):
-            u[j] += dt * vn[j]
-            th[j] += dt * wn[j]
-        v, vn = vn, v
-        w, wn = wn, w
+        last = t + dt >= t_stop or steps + 1 >= max_steps
+        # the velocity terms with the drift (the system is lower bidiagonal: one pass in
+        # the direction of the flow), and the kick of node j - 1 once its neighbours
+        # have drifted; node N passes through with zero coefficients, so the loop needs
+        # no branches (written out: a numba call here costs 10x the work)
+        mv = P[1] * va[1]
+        mw = P[1] * wa[1]
+        u[1] += dt * mv
+        th[1] += dt * mw
+        va[1] = 2.0 * mv - va[1]
+        wa[1] = 2.0 * mw - wa[1]
+        for j in range(2, N + 1):
+            mv = P[j] * va[j] + Ql[j] * mv
+            mw = P[j] * wa[j] + Ql[j] * mw
+            u[j] += dt * mv
+            th[j] += dt * mw
+            va[j] = 2.0 * mv - va[j]
+            wa[j] = 2.0 * mw - wa[j]
+            k = j - 1
+            eu = ar[k] * (u[k + 1] - u[k]) - al[k] * (u[k] - u[k - 1])
+            et = (br[k] * (th[k + 1] - th[k]) - bl[k] * (th[k] - th[k - 1])
+                  - spring * th[k])
+            if last:
+                ud[k] = va[k]
+                td[k] = wa[k]
+            bb[k] = va[k] + hh * wa[k]
+            eb[k] = eu + hh * et
+            va[k] += eu
+            wa[k] += et
         t += dt
         steps += 1
-    if steps % 2 == 1:  # the caller's arrays hold the buffers of the previous step
-        vn[:] = v
-        wn[:] = w
+        _add_loads(va, wa, eb, t, dt, p, loads)
+        _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, mismatch(drive, t), co, mesh,
+                       p)
+        if last:
+            for j in range(1, N):
+                ud[j] = 0.5 * (ud[j] + va[j])
+                td[j] = 0.5 * (td[j] + wa[j])
     return t, steps
+
+
+# ---------------------------------------------------------------------------
+# von Neumann analysis
+
+
+def _gyro_symbol(c, h, kh):
+    """G over the lumped mass on a uniform grid (1/s), for the mode e^{i kh j}."""
+    return 2.0 * c * (1.0 - np.exp(-1j * kh)) / h
+
+
+def _amplification_matrices(params, h, dt, damping, kh, z):
+    """Amplification matrices (..., 5, 5) of one step on a uniform grid of elements h.
+
+    The state (u, theta, v_a, w_a, delta_b of the last kick) of the mode e^{i kh j},
+    every node in contact with a friction law of slope k, z = dt k (1/rho + (h/2)^2 / I);
+    kh and z broadcast against each other.
+    """
+    P = params
+    rho, rot, c, hh = P.rho, P.I, P.c, 0.5 * P.h
+    kh, z = np.broadcast_arrays(np.asarray(kh, float), np.asarray(z, float))
+    trap = (2.0 / dt) / (2.0 / dt + damping + _gyro_symbol(c, h, kh))  # vm = trap v_a
+    lap = -(2.0 - 2.0 * np.cos(kh)) / h**2
+    up = c * dt * (1.0 - np.exp(-1j * kh)) / h  # c dt D_upwind (the slip velocity's)
+    kb = 1.0 / rho + hh * hh / rot
+    a = A_EST + ALPHA * up
+    cols = []
+    for col in range(5):
+        u, th, va, wa, dp = (1.0 if i == col else 0.0 for i in range(5))
+        vm, wm = trap * va, trap * wa
+        vb, wb = 2.0 * vm - va, 2.0 * wm - wa
+        u1, t1 = u + dt * vm, th + dt * wm
+        eu = dt * (P.B / rho) * lap * u1
+        et = dt * ((P.A / rot) * lap - P.b2 / rot) * t1
+        eb = eu + hh * et
+        vrel = ((vb + hh * wb) - C_EST * dp + (up / dt) * (u1 + hh * t1) + a * eb) / (1.0 + a * z)
+        du = eu - z / (rho * kb) * vrel
+        dw = et - z * hh / (rot * kb) * vrel
+        cols.append(np.stack([u1, t1, vb + du, wb + dw, du + hh * dw], axis=-1))
+    return np.stack(cols, axis=-1)
+
+
+def _wave_amplification(params, h, dt, damping):
+    """Largest amplification without friction, in closed form (each field on its own).
+
+    Per field, in (u, dt v_a): [[1, tau], [q, 2 tau - 1 + q tau]] with q = -dt^2 omega^2,
+    tau = 1 / (1 + s) and s = (d + G) dt / 2; its eigenvalues
+    tau ((1 + q/2) +- sqrt(s^2 + q + q^2/4)) carry no cancellation at small dt.
+    """
+    P = params
+    kh = np.linspace(np.pi / 4096, np.pi, 4096)
+    s = 0.5 * dt * (damping + _gyro_symbol(P.c, h, kh))
+    tau = 1.0 / (1.0 + s)
+    worst = 0.0
+    for stiff, inertia, spring in ((P.B, P.rho, 0.0), (P.A, P.I, P.b2)):
+        q = -dt * dt * ((stiff / inertia) * (2.0 - 2.0 * np.cos(kh)) / h**2 + spring / inertia)
+        root = np.sqrt(s * s + q + 0.25 * q * q + 0j)
+        lam = np.maximum(np.abs(1.0 + 0.5 * q + root), np.abs(1.0 + 0.5 * q - root))
+        worst = max(worst, float((np.abs(tau) * lam).max()))
+    return worst
+
+
+def _coupled_amplification(params, h, dt, damping):
+    """Largest amplification with friction: all slopes of FRICTION_Z, both fields coupled."""
+    kh = np.linspace(np.pi / 96, np.pi, 96)
+    G = _amplification_matrices(params, h, dt, damping, kh[None, :], FRICTION_Z[:, None])
+    return float(np.abs(np.linalg.eigvals(G)).max())
 
 
 def explicit_amplification(params, h, dt, damping):
     """Largest von Neumann amplification of the explicit scheme on elements of size h.
 
-    Both fields: the axial one (wave speed sqrt(b1/rho)) and the rotation (sqrt(a/I)
-    with the shear term b2/I); the upwind gyroscopic term and the damping included.
+    Both fields with their gyroscopic, damping, stiffness and shear terms, and friction
+    at every slope of FRICTION_Z with its velocity estimate and the transport of the
+    slip velocity (the stick limit included).
     """
-    kh = np.linspace(1e-4, np.pi, 2000)
-    worst = 0.0
-    P = params
-    for stiff, inertia, spring in ((P.B, P.rho, 0.0), (P.A, P.I, P.b2)):
-        G = 2.0 * P.c * (1.0 - np.exp(-1j * kh)) / h
-        w2 = (stiff / inertia) * (2.0 - 2.0 * np.cos(kh)) / h**2 + spring / inertia
-        # amplification matrix of (u^n, v^{n-1/2}): [[1 - dt^2 w2, dt a], [-dt w2, a]];
-        # its discriminant from p - s = dt (G + d) - dt^2 w2 and q r = -dt^2 w2 a, with
-        # no cancellation at small dt (tr^2/4 - det would lose it all)
-        a = 1.0 - dt * (G + damping)
-        half_tr = 0.5 * (1.0 - dt * dt * w2 + a)
-        disc = np.sqrt((0.5 * (dt * (G + damping) - dt * dt * w2)) ** 2 - dt * dt * w2 * a
-                       + 0j)
-        lam = np.maximum(np.abs(half_tr + disc), np.abs(half_tr - disc))
-        worst = max(worst, float(lam.max()))
-    return worst
+    return max(_wave_amplification(params, h, dt, damping),
+               _coupled_amplification(params, h, dt, damping))
 
 
-def explicit_stable_dt(params, h_min, damping):
-    """The largest step with amplification <= 1 on the smallest element (bisection).
-
-    Bounded by the CFL step h_min / (c + max characteristic speed); returns 0 when no
-    step is stable (the rotation equation needs some damping: see the module notes).
-    """
-    P = params
-    speed = P.c + max(np.sqrt(P.b1 / P.rho), np.sqrt(P.a / P.I))
-    hi = 2.0 * h_min / speed
-    lo = 0.0
-    tol = 1e-12
+@lru_cache(maxsize=256)
+def _stable_dt(B, A, b2, rho, rot, c, height, h_min, damping):
+    P = SimpleNamespace(B=B, A=A, b2=b2, rho=rho, I=rot, c=c, h=height)
+    # the stiffness terms' limit, in closed form, by bisection
+    w2 = max(4.0 * B / (rho * h_min**2), 4.0 * A / (rot * h_min**2) + b2 / rot)
+    lo, hi = 0.0, 4.0 / math.sqrt(w2)  # twice the leapfrog's 2 / omega_max
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        if explicit_amplification(P, h_min, mid, damping) <= 1.0 + tol:
+        if _wave_amplification(P, h_min, mid, damping) <= 1.0 + TOL:
             lo = mid
         else:
             hi = mid
-    return lo
+    wave = lo
+    # friction can lower it (modes it couples weakly near the waves' limit): the first
+    # stable fraction of it, refined between that and the last unstable one
+    unstable = wave
+    for frac in (1.0, 0.999, 0.99, 0.97, 0.9, 0.8, 0.65, 0.5, 0.35, 0.2, 0.1, 0.05):
+        stable = frac * wave
+        if _coupled_amplification(P, h_min, stable, damping) <= 1.0 + TOL:
+            break
+        unstable = stable
+    else:
+        return 0.0
+    for _ in range(4 if unstable > stable else 0):
+        mid = 0.5 * (stable + unstable)
+        if _coupled_amplification(P, h_min, mid, damping) <= 1.0 + TOL:
+            stable = mid
+        else:
+            unstable = mid
+    return stable
+
+
+def explicit_stable_dt(params, h_min, damping):
+    """The largest step with amplification <= 1 on the smallest element; 0 when none is."""
+    P = params
+    return _stable_dt(float(P.B), float(P.A), float(P.b2), float(P.rho), float(P.I),
+                      float(P.c), float(P.h), float(h_min), float(damping))
 
 
 @register
 class ExplicitScheme(Scheme):
-    """Staggered leapfrog at EXPLICIT_SAFETY of the von Neumann limit (inertial scenes)."""
+    """Trapezoidal velocity terms and an explicit kick (module notes), at EXPLICIT_SAFETY
+    of the von Neumann limit (inertial scenes)."""
 
     name = "explicit"
     needs_inertia = True
@@ -209,33 +489,52 @@ class ExplicitScheme(Scheme):
     def __init__(self, disc):
         super().__init__(disc)
         P, num, grid = disc.params, self.numerics, disc.grid
-        damping = disc.model.damping
-        limit = explicit_stable_dt(P, grid.h_min, damping)
-        cfl = grid.h_min / (P.c + max(math.sqrt(P.b1 / P.rho), math.sqrt(P.a / P.I)))
-        if limit < 0.05 * cfl:
-            raise SceneError(
-                f"physics.damping: the explicit scheme is unstable with damping = "
-                f"{damping:.6g} 1/s on this grid (its explicit gyroscopic term in the "
-                f"rotation equation needs damping); use the implicit integrator")
+        limit = explicit_stable_dt(P, grid.h_min, disc.model.damping)
+        if not limit > 0.0:
+            raise SceneError("numerics.integrator: the explicit scheme has no stable step "
+                             "for this scene; use the implicit integrator")
         requested = disc.scene.numerics.get("dt")
         if requested is not None and requested > limit:
             raise SceneError(
                 f"numerics.dt: {requested:.6g} s exceeds the explicit stability limit "
-                f"{limit:.6g} s (characteristic speeds c + sqrt(b1/rho), c + sqrt(a/I) on the "
-                f"smallest element, {grid.h_min:.3g} m, with the gyroscopic and shear terms)")
+                f"{limit:.6g} s (von Neumann, on the smallest element, {grid.h_min:.3g} m: "
+                f"the waves of both fields with the shear, gyroscopic and friction terms)")
         dt = requested if requested is not None else EXPLICIT_SAFETY * limit
         self.numerics = dataclasses.replace(num, dt=dt)
+        self.hist = History.zeros(grid.n_elements + 1)
+        self.hist_at = (math.nan, math.nan)  # the (t, dt) the history belongs to
 
     @property
     def dt(self) -> float:
         return self.numerics.dt
 
     def _compile(self, state) -> None:
-        self.advance(state, 0.0, 0.0, max_steps=0)
+        # on copies: a resumed run's history must survive the warm-up
+        self._kernel(state.copy(), History.zeros(len(state.u)), True, 0.0, 0.0, 0)
+
+    def _kernel(self, state, hist, fresh, t, t_stop, max_steps):
+        d = self.disc
+        return advance_explicit(state, hist, fresh, t, t_stop, self.numerics.dt, max_steps,
+                                d.mesh, d.model, d.drive, d.loads)
 
     def advance(self, state, t, t_stop, max_steps=10**9):
-        d = self.disc
-        t, steps = advance_explicit(state, t, t_stop, self.numerics.dt, max_steps, d.mesh,
-                                    d.model, d.drive, d.loads)
+        # a history from another time or step (a new run, a state set from outside, a
+        # changed dt) is rebuilt from the state
+        fresh = self.hist_at != (t, self.numerics.dt)
+        t, steps = self._kernel(state, self.hist, fresh, t, t_stop, max_steps)
+        self.hist_at = (t, self.numerics.dt)
         self.steps += steps
         return t
+
+    def checkpoint(self) -> dict:
+        return {**super().checkpoint(), "hist_at": np.array(self.hist_at),
+                **{f"hist_{k}": a.copy() for k, a in zip(History._fields, self.hist)}}
+
+    def restore(self, data: dict) -> None:
+        super().restore(data)
+        if "hist_at" not in data:  # a checkpoint of the first-order scheme: start afresh
+            self.hist_at = (math.nan, math.nan)
+            return
+        self.hist_at = tuple(float(v) for v in data["hist_at"])
+        for k, a in zip(History._fields, self.hist):
+            a[:] = data[f"hist_{k}"]

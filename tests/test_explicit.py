@@ -1,0 +1,292 @@
+"""The explicit scheme: its step limit, its order in time, zero damping, a numpy twin."""
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import beltsim
+from beltsim.physics.friction import law_numpy
+from beltsim.physics.model import Loads, State, forces_numpy
+from beltsim.problem.drive import mismatch
+from beltsim.problem.scene import Scene
+from beltsim.simulation.controller import Simulation
+from beltsim.simulation.trackers import GROWTH_LIMIT
+from beltsim.solvers import Discretisation
+from beltsim.solvers.explicit import (
+    A_EST,
+    ALPHA,
+    C_EST,
+    EXPLICIT_SAFETY,
+    History,
+    _friction_scalar,
+    advance_explicit,
+    explicit_amplification,
+    explicit_stable_dt,
+)
+from helpers import scene_path
+
+
+def _scene(name, *overrides):
+    return beltsim.load_scene(scene_path(name), ["numerics.elements=300", *overrides])
+
+
+def _steps(d, state, hist, fresh, t, dt, n):
+    """n explicit steps of size dt from t (the kernel alone); returns the new time."""
+    t, done = advance_explicit(state, hist, fresh, t, np.inf, dt, n, d.mesh, d.model, d.drive,
+                               d.loads)
+    assert done == n
+    return t
+
+
+def test_requested_step_above_the_explicit_limit_is_refused():
+    sim = Simulation(_scene("paper_inertia", "numerics.integrator=explicit"))
+    limit = sim.numerics.dt / EXPLICIT_SAFETY
+    with pytest.raises(beltsim.SceneError, match=r"^numerics\.dt: .* exceeds the explicit"):
+        Simulation(_scene("paper_inertia", "numerics.integrator=explicit",
+                          f"numerics.dt={1.01 * limit}"))
+    Simulation(_scene("paper_inertia", "numerics.integrator=explicit",
+                      f"numerics.dt={0.99 * limit}"))
+
+
+def test_limit_does_not_depend_on_damping_or_friction_stiffness():
+    """The gyroscopic and damping terms are trapezoidal and friction implicit, so the
+    limit is the waves' (h / sqrt(B / rho) on the smallest element, 2.2 times the old
+    leapfrog's h / (c + sqrt(b1 / rho))), whatever the damping or f* / v_reg."""
+    steps = {}
+    for extra in ([], ["physics.damping=0"], ["physics.damping=651"],
+                  ["numerics.regularisation=1e-9", "contact.max_friction=1e8"]):
+        sim = Simulation(_scene("paper_slip", "numerics.integrator=explicit", *extra))
+        steps[tuple(extra)] = sim.numerics.dt / EXPLICIT_SAFETY
+        P = sim.params
+        waves = sim.grid.h_min / np.sqrt(P.B / P.rho)
+        assert 0.99 * waves < steps[tuple(extra)] <= waves * (1 + 1e-6)
+    assert max(steps.values()) < 1.01 * min(steps.values())
+
+
+@pytest.mark.parametrize("damping", [0.0, 39.0])
+def test_explicit_limit_is_sharp(damping):
+    """Independent check of the von Neumann limit: just below it the kernel stays
+    bounded, 30% above it the same run grows without bound. v = c, so nothing but the
+    initial noise drives the state (and friction holds the contact zone in stick)."""
+    sc = _scene("paper_inertia", "numerics.grading=1", "numerics.elements=200",
+                "motion.surface_speed=120", f"physics.damping={damping}")
+    d = Discretisation(sc)
+    limit = explicit_stable_dt(d.params, d.grid.h_min, d.model.damping)
+
+    def growth(dt_factor):
+        state = d.new_state()
+        rng = np.random.default_rng(0)
+        state.u[1:-1] = 1e-6 * rng.standard_normal(len(state.u) - 2)
+        state.theta[1:-1] = 1e-6 * rng.standard_normal(len(state.u) - 2)
+        with np.errstate(all="ignore"):
+            _steps(d, state, History.zeros(len(state.u)), True, 0.0, dt_factor * limit, 20000)
+        return np.abs(state.u).max() / 1e-6
+
+    assert growth(0.99) < 10.0
+    assert not growth(1.3) < GROWTH_LIMIT  # overflowed or grew by > 1e4
+
+
+@pytest.mark.parametrize("damping", [0.0, 39.0])
+def test_amplification_is_one_for_a_tiny_step_and_exceeds_one_beyond_the_limit(damping):
+    P = Scene.load(scene_path("paper_inertia")).params
+    h = 1e-3
+    assert explicit_amplification(P, h, 1e-12, damping) <= 1.0 + 1e-12
+    limit = explicit_stable_dt(P, h, damping)
+    assert explicit_amplification(P, h, limit, damping) <= 1.0 + 1e-9
+    assert explicit_amplification(P, h, 1.3 * limit, damping) > 1.01
+
+
+def _self_convergence(d, state0, span, quantities=("u", "theta", "ud", "td", "fnode")):
+    """Observed orders in time from runs at dt, dt/2, dt/4, dt/8 over the same span."""
+    limit = explicit_stable_dt(d.params, d.grid.h_min, d.model.damping)
+    n = int(np.ceil(span / (0.8 * limit)))
+    finals = []
+    for r in (1, 2, 4, 8):
+        state = state0.copy()
+        t = _steps(d, state, History.zeros(len(state.u)), True, 0.0, span / (n * r), n * r)
+        assert t == pytest.approx(span, rel=1e-12)
+        finals.append(state)
+    orders = {}
+    for q in quantities:
+        diffs = [np.abs(getattr(finals[k], q) - getattr(finals[k + 1], q)).max()
+                 for k in range(3)]
+        orders[q] = [np.log2(diffs[k] / diffs[k + 1]) for k in range(2)]
+    return orders
+
+
+def test_second_order_in_time_with_a_smooth_friction_law():
+    """During the ramp of the paper slip scene, with a wide regularisation (v_reg
+    0.05 m/s, so friction is smooth): positions, rates and friction forces converge
+    at second order."""
+    d = Discretisation(_scene("paper_slip", "numerics.elements=60",
+                              "numerics.regularisation=0.05"))
+    orders = _self_convergence(d, d.new_state(), 0.01)
+    for q, o in orders.items():
+        assert min(o) >= 1.9, (q, o)
+
+
+def test_second_order_in_time_from_a_moving_state_with_loads():
+    """A start from a moving state (the history is rebuilt from u_t, theta_t), with
+    distributed loads that vary in time: still second order. The friction is mild
+    (v_reg 5 m/s): a stiff one relaxes from such a state in a layer shorter than the
+    steps, which lowers the observed order (1.2-1.4 at v_reg 0.05 m/s) as it would for
+    any scheme that does not resolve the layer."""
+    d = Discretisation(_scene("paper_slip", "numerics.elements=60",
+                              "numerics.regularisation=5", "physics.damping=0"))
+    x, L, span = d.grid.x, d.params.L, 0.01
+    shape = np.sin(np.pi * x / L)
+    # loads growing as (t / span)^2: cubic Hermite data reproduces them exactly
+    qu = np.array([0.0 * shape, 2e3 * shape])
+    qt = np.array([0.0 * shape, -50.0 * shape])
+    d.loads = Loads(np.array([0.0, span]), qu, qt, 2.0 * qu / span, 2.0 * qt / span)
+    state = d.new_state()
+    state.u[:] = 1e-4 * shape
+    state.ud[:] = 0.05 * np.sin(2 * np.pi * x / L)
+    state.td[:] = 0.2 * shape
+    orders = _self_convergence(d, state, span)
+    for q, o in orders.items():
+        assert min(o) >= 1.9, (q, o)
+
+
+def test_zero_damping_runs_stably():
+    """Without damping the scheme neither grows nor fails: the paper slip scene runs its
+    span and stays at the size of the steady state (the semi-discrete model with the
+    upwind gyroscopic term decays on this grid; the scheme adds no growth)."""
+    scene = _scene("paper_slip", "numerics.integrator=explicit", "numerics.elements=150",
+                   "physics.damping=0", "numerics.t_end=0.3")
+    res = beltsim.run(scene, raise_on_failure=False)
+    assert res.status in (beltsim.RunStatus.REACHED_END, beltsim.RunStatus.CONVERGED)
+    exact_u = np.abs(res.reference.fields(res.solution.x)["u"]).max()
+    assert np.all(np.isfinite(res.solution.u)) and np.all(np.isfinite(res.solution.theta))
+    assert np.abs(res.solution.u).max() < 1.5 * exact_u
+    # the rates fall from the ramp's to a small fraction of it
+    rate = res.history["rate"]
+    assert rate[-1] < 0.2 * rate.max()
+
+
+def test_stiff_friction_sets_no_step_limit():
+    """v_reg 1e-9 m/s with f* 1e8 N/m: friction slopes 1e17 N s/m^2, and the default
+    step; the friction forces stay bounded and do not alternate from step to step."""
+    sim = Simulation(_scene("paper_slip", "numerics.integrator=explicit",
+                            "numerics.elements=100", "numerics.regularisation=1e-9",
+                            "contact.max_friction=1e8"))
+    sim.advance(0.05)
+    forces = []
+    for _ in range(4):
+        sim.advance(sim.t + 0.5 * sim.numerics.dt, max_steps=1)
+        forces.append(sim.state.fnode.copy())
+    forces = np.array(forces)
+    assert np.all(np.isfinite(forces))
+    assert np.abs(np.diff(forces, axis=0)).max() < 1e-2 * np.abs(forces).max()
+    assert np.abs(sim.state.u).max() < 10 * sim.disc.scales.u
+
+
+def test_chunks_continue_the_history():
+    """Advancing in chunks (as the run loop does) is the same arithmetic as one
+    advance: the history carries over, bit for bit."""
+    scene = _scene("paper_slip", "numerics.integrator=explicit", "numerics.elements=80")
+    whole, parts = Simulation(scene), Simulation(scene)
+    whole.advance(0.02)
+    while parts.t < 0.02:
+        parts.advance(min(parts.t + 0.003, 0.02))
+    assert whole.steps == parts.steps and whole.t == parts.t
+    for a, b in zip(whole.state, parts.state):
+        np.testing.assert_array_equal(a, b)
+
+
+def _explicit_step_numpy(d, u, th, va, wa, db, t, dt):
+    """Numpy twin of one explicit step, written from the scheme's definition: the
+    velocity terms by the trapezoidal rule (a dense solve) with the drift, then the
+    kick at t + dt with friction solved node by node in the direction of the flow.
+    Returns u, theta, the velocities after the kick, its bottom increments, the
+    friction and the rates at t + dt."""
+    P, p, mesh = d.params, d.model, d.mesh
+    c, hh, dmp = P.c, 0.5 * P.h, p.damping
+    he, hb, j1, j2 = mesh.he, mesh.hb, mesh.j1, mesh.j2
+    n = len(u)
+    inner = np.arange(1, n - 1)
+
+    def velocity_terms(v, mass):  # upwind gyroscopic and damping forces of velocities v
+        f = np.zeros(n)
+        f[inner] = (2.0 * mass * c * hb[inner] * (v[inner] - v[inner - 1]) / he[inner - 1]
+                    + dmp * mass * hb[inner] * v[inner])
+        return f
+
+    def trapezoid(v, mass):  # m (vb - va) / dt + f((va + vb) / 2) = 0, f linear
+        A = np.array([velocity_terms(e, mass)[inner] for e in np.eye(n)]).T[:, inner]
+        m = mass * hb[inner]
+        lhs = np.diag(m / dt) + 0.5 * A
+        rhs = m / dt * v[inner] - 0.5 * A @ v[inner]
+        out = np.zeros(n)
+        out[inner] = np.linalg.solve(lhs, rhs)
+        return out
+
+    vb, wb = trapezoid(va, P.rho), trapezoid(wa, P.I)
+    u1, th1 = u + 0.5 * dt * (va + vb), th + 0.5 * dt * (wa + wb)
+    t1 = t + dt
+    fu, ft, _ = forces_numpy(u1, th1, 0 * u, 0 * u, t1, mesh, p._replace(friction_scale=0.0),
+                             d.drive, d.loads)
+    m, mi = P.rho * hb, P.I * hb
+    eu, et = np.zeros(n), np.zeros(n)
+    eu[inner], et[inner] = dt * fu / m[inner], dt * ft / mi[inner]
+    F = np.zeros(n)
+    ub1 = u1 + hh * th1
+    delta = eu + hh * et  # bottom-fibre increments, friction added node by node
+    target = mismatch(d.drive, t1)
+    for j in range(j1 + 1, j2 + 1):
+        h = he[j - 1]
+        kb = dt * (1 / m[j] + hh * hh / mi[j])
+
+        def force(vhat, h=h):
+            return -h * p.friction_scale * law_numpy(p.law, vhat / p.v_reg)[0]
+
+        def slip(vhat, j=j, h=h, kb=kb):  # the slip velocity's estimate, given the force
+            dj = delta[j] + kb * force(vhat)
+            transport = (ub1[j] + ALPHA * dt * dj) - (ub1[j - 1] + ALPHA * dt * delta[j - 1])
+            return vb[j] + hh * wb[j] + A_EST * dj - C_EST * db[j] + c / h * transport - target
+
+        span = abs(slip(0.0)) + (A_EST + ALPHA * c * dt / h) * kb * h * p.friction_scale + 1.0
+        vhat = brentq(lambda x: x - slip(x), -span, span, xtol=1e-15, rtol=1e-14)
+        F[j] = force(vhat)
+        delta[j] += kb * F[j]
+    va1 = vb + eu + dt * F / m
+    wa1 = wb + et + dt * hh * F / mi
+    return u1, th1, va1, wa1, delta, F, 0.5 * (vb + va1), 0.5 * (wb + wa1)
+
+
+@pytest.mark.parametrize("name", ["paper_slip", "paper_inertia"])
+def test_explicit_step_matches_numpy_twin(name):
+    d = Discretisation(_scene(name, "numerics.elements=60", "numerics.regularisation=0.01")
+                       if name == "paper_slip" else _scene(name, "numerics.elements=60"))
+    dt = EXPLICIT_SAFETY * explicit_stable_dt(d.params, d.grid.h_min, d.model.damping)
+    n = len(d.grid.x)
+    rng = np.random.default_rng(5)
+    u, th = (1e-4 * rng.standard_normal(n) for _ in range(2))
+    va, wa, db = (1e-2 * rng.standard_normal(n) for _ in range(3))
+    for a in (u, th, va, wa):
+        a[[0, -1]] = 0.0
+    t = 0.5 * d.drive.ramp_time  # mid-ramp: the drive changes over the step
+    ref = _explicit_step_numpy(d, u, th, va, wa, db, t, dt)
+    state = State(u.copy(), th.copy(), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n))
+    hist = History(va.copy(), wa.copy(), db.copy())
+    _steps(d, state, hist, False, t, dt, 1)
+    j = np.arange(d.mesh.j1 + 1, d.mesh.j2 + 1)
+    got = (state.u, state.theta, hist.va, hist.wa, hist.db[j], state.fnode, state.ud, state.td)
+    want = ref[:4] + (ref[4][j],) + ref[5:]
+    for name_, g, w in zip(("u", "theta", "va", "wa", "db", "fnode", "ud", "td"), got, want):
+        np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-10 * np.abs(w).max(), err_msg=name_)
+
+
+@pytest.mark.parametrize("code", [0, 1, 2, 3])
+def test_friction_scalar_solves_its_equation(code):
+    rng = np.random.default_rng(code)
+    for i in range(400):
+        s_pred = rng.standard_normal() * 10 ** rng.uniform(-3, 5)
+        kappa = 10 ** rng.uniform(-2, 4)
+        # warm starts anywhere, and (sliding nodes) just off the edge of the bracket
+        s0 = (rng.standard_normal() * 10 ** rng.uniform(-3, 3) if i % 2
+              else s_pred + np.sign(rng.standard_normal()) * kappa * (1 + 1e-16 * i))
+        s, g = _friction_scalar(code, s_pred, kappa, s0)
+        gs = law_numpy(code, s)[0]
+        assert g == pytest.approx(gs, abs=1e-9)
+        assert s + kappa * gs == pytest.approx(s_pred, abs=1e-9 * (abs(s_pred) + kappa))
