@@ -107,9 +107,11 @@ def stability_cell(case: Case, scheme: str, extra=()) -> dict:
     cell.update(dt=sim.numerics.dt if sim.scheme.transient else float("nan"),
                 steps=res.steps, wall_time=res.wall_time,
                 **{f"error_{k}": err[k] for k in ERROR_KEYS if err.get(k) is not None})
-    if case.span and res.status in (RunStatus.REACHED_END, RunStatus.CONVERGED):
+    if (case.span and sim.scheme.transient
+            and res.status in (RunStatus.REACHED_END, RunStatus.CONVERGED)):
         cell.update(status=CellStatus.BOUNDED,
-                    reason=f"t = {res.simulated_time:.3g} s, final rate {res.history['rate'][-1]:.3g}")
+                    reason=f"t = {res.simulated_time:.3g} s, final rate "
+                           f"{res.history['rate'][-1]:.3g}")
     elif not res.converged:
         cell.update(status=_RUN_STATUS[res.status], reason=res.reason)
     else:
