@@ -8,7 +8,10 @@ speed c, and D/Dt = d/dt + c d/dx. With B = b1 - rho c^2 and A = a - I c^2::
     f = -f_s g(v_rel / v_reg),  v_rel = d/dt u_b + c d/dx u_b - (v(t) - c),  u_b = u + (h/2) theta
 
 Space: linear elements with lumped mass and shear (node-centred control
-volumes); the gyroscopic term 2 c u_xt is central (skew, energy neutral). The
+volumes); the gyroscopic term 2 c u_xt is upwind, 2 rho c hbar_j (v_j - v_{j-1}) /
+h_{j-1} (the central, skew form leaves a mode that grows at the paper slip steady
+state, +2.5 1/s with the paper's damping: friction in the stick zone pumps the
+rotation; upwind, the slowest mode decays at 10 1/s; both vanish at steady state). The
 transport c d/dx u_b in the slip velocity is upwind: the slip velocity of the
 element [x_{j-1}, x_j] uses the bottom-fibre strain of that element and the
 velocity of its downstream node j, and the element's friction is lumped on node
@@ -191,14 +194,13 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
         udj = (u[j] - uo[j]) * inv_dt
         tdj = (th[j] - tho[j]) * inv_dt
         ud_l = (u[j - 1] - uo[j - 1]) * inv_dt
-        ud_r = (u[j + 1] - uo[j + 1]) * inv_dt
         td_l = (th[j - 1] - tho[j - 1]) * inv_dt
-        td_r = (th[j + 1] - tho[j + 1]) * inv_dt
+        gyro = 2.0 * c * hbj / hl  # upwind 2 c u_xt over the control volume
         acc_u = (udj - udo[j]) * inv_dt + damp * udj
         acc_t = (tdj - tdo[j]) * inv_dt + damp * tdj
-        ru = (rho * hbj * acc_u + rho * c * (ud_r - ud_l)
+        ru = (rho * hbj * acc_u + rho * gyro * (udj - ud_l)
               - B * ((u[j + 1] - u[j]) / hr - (u[j] - u[j - 1]) / hl))
-        rt = (I * hbj * acc_t + I * c * (td_r - td_l)
+        rt = (I * hbj * acc_t + I * gyro * (tdj - td_l)
               - A * ((th[j + 1] - th[j]) / hr - (th[j] - th[j - 1]) / hl) + b2 * hbj * th[j])
         if lk >= 0:
             ru -= hbj * load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j)
@@ -209,12 +211,13 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
                     Lb[i, a_, b_] = 0.0
                     Db[i, a_, b_] = 0.0
                     Ub[i, a_, b_] = 0.0
-            Db[i, 0, 0] = rho * hbj * kin + B * (1.0 / hl + 1.0 / hr)
-            Lb[i, 0, 0] = -rho * c * inv_dt - B / hl
-            Ub[i, 0, 0] = rho * c * inv_dt - B / hr
-            Db[i, 1, 1] = I * hbj * kin + A * (1.0 / hl + 1.0 / hr) + b2 * hbj
-            Lb[i, 1, 1] = -I * c * inv_dt - A / hl
-            Ub[i, 1, 1] = I * c * inv_dt - A / hr
+            Db[i, 0, 0] = rho * hbj * kin + rho * gyro * inv_dt + B * (1.0 / hl + 1.0 / hr)
+            Lb[i, 0, 0] = -rho * gyro * inv_dt - B / hl
+            Ub[i, 0, 0] = -B / hr
+            Db[i, 1, 1] = (I * hbj * kin + I * gyro * inv_dt + A * (1.0 / hl + 1.0 / hr)
+                           + b2 * hbj)
+            Lb[i, 1, 1] = -I * gyro * inv_dt - A / hl
+            Ub[i, 1, 1] = -A / hr
         if j > j1 and j <= j2:
             # element [j-1, j]: upwind strain, velocity of the downstream node
             ub = u[j] + hh * th[j]
@@ -330,15 +333,17 @@ def traction(fnode, he):
 
 
 # Power balance of the semi-discrete model. Multiplying the equations of motion by the
-# local velocities, the skew gyroscopic term drops out and
-#     dE/dt = P_surface + P_transport + P_loads - D_slip - D_damping
+# local velocities:
+#     dE/dt = P_surface + P_transport + P_loads - D_slip - D_damping - D_gyroscopic
 # with E = 1/2 sum hbar (rho u_t^2 + I theta_t^2) + 1/2 (B sum (du)^2/h + A sum (dtheta)^2/h
 # + b2 sum hbar theta^2) (B, A: the effective stiffnesses of the moving belt), and, with
 # the nodal friction F_j and u_b = u + (h/2) theta, sum F_j d/dt u_b,j split along
 # v_rel = d/dt u_b + c d/dx u_b - (v(t) - c): the slip dissipation D_slip = -sum F v_rel
 # (>= 0), the surface's power P_surface = (v(t) - c) sum F, and the transport part
-# P_transport = -c sum F d/dx u_b (the strain carried through the contact).
-POWER_TERMS = ("surface", "transport", "loads", "slip", "damping")
+# P_transport = -c sum F d/dx u_b (the strain carried through the contact), and
+# D_gyroscopic = sum v_j 2 rho c hbar_j (v_j - v_{j-1}) / h_{j-1} (+ theta), the upwind
+# gyroscopic term's dissipation plus the flux out at x = L (>= 0 on a uniform grid).
+POWER_TERMS = ("surface", "transport", "loads", "slip", "damping", "gyroscopic")
 
 
 @njit(cache=True)
@@ -365,7 +370,13 @@ def power_terms(state, t, mesh, p, drive, loads, out):
         if lk >= 0:
             load += hb[j] * (load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j) * ud[j]
                              + load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j) * td[j])
-    out[0], out[1], out[2], out[3], out[4] = surface, transport, load, slip, damping
+    gyro = 0.0
+    for j in range(1, u.shape[0] - 1):
+        g = 2.0 * c * hb[j] / he[j - 1]
+        gyro += g * (p.mass * ud[j] * (ud[j] - ud[j - 1])
+                     + p.rotary_inertia * td[j] * (td[j] - td[j - 1]))
+    out[0], out[1], out[2], out[3], out[4], out[5] = (surface, transport, load, slip,
+                                                      damping, gyro)
 
 
 def stored_energy(state, mesh: Mesh, p: ModelParams) -> float:
@@ -399,9 +410,10 @@ def forces_numpy(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, loads=None
     vrel = ud[j] + hh * td[j] + c * (ub[j] - ub[j - 1]) / he[j - 1] - mismatch(drive, t)
     F[j] = -he[j - 1] * p.friction_scale * law_numpy(p.law, vrel / p.v_reg)[0]
     sl = slice(1, -1)
-    fu = (B * np.diff(np.diff(u) / he) - rho * c * (ud[2:] - ud[:-2])
+    gyro = 2.0 * c * hb[sl] / he[:-1]
+    fu = (B * np.diff(np.diff(u) / he) - rho * gyro * (ud[sl] - ud[:-2])
           - p.damping * rho * hb[sl] * ud[sl] + F[sl])
-    ft = (A * np.diff(np.diff(th) / he) - b2 * hb[sl] * th[sl] - I * c * (td[2:] - td[:-2])
+    ft = (A * np.diff(np.diff(th) / he) - b2 * hb[sl] * th[sl] - I * gyro * (td[sl] - td[:-2])
           - p.damping * I * hb[sl] * td[sl] + hh * F[sl])
     if loads is not None and len(loads.times):
         k, *wts = hermite_weights(loads.times, t)

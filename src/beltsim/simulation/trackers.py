@@ -220,11 +220,12 @@ class PowerBalanceTracker(Tracker):
         from ..physics.model import stored_energy
         work = sim.scheme.work_integrals()
         change = stored_energy(sim.state, sim.disc.mesh, sim.disc.model) - self.initial_energy
-        dissipated = work["slip"] + work["damping"]
+        dissipated = work["slip"] + work["damping"] + work["gyroscopic"]
         residual = change - (work["surface"] + work["transport"] + work["loads"] - dissipated)
         return {"stored_energy_change": change, "surface_work": work["surface"],
                 "transport_work": work["transport"], "load_work": work["loads"],
                 "slip_dissipation": work["slip"], "damping_dissipation": work["damping"],
+                "gyroscopic_dissipation": work["gyroscopic"],
                 "residual": residual,
                 "relative_residual": abs(residual) / dissipated if dissipated > 0 else None}
 

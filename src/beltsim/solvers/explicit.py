@@ -20,10 +20,8 @@ Only the kick's stiffness terms are explicit: the step is limited by the waves
 h / (c + sqrt(b1 / rho))). Both parts vanish at rest, so the fixed point is the
 semi-discrete steady state of the implicit schemes.
 
-G is upwind, 2 rho c hbar_j (v_j - v_{j-1}) / h_{j-1} (the old scheme's form), where
-the implicit schemes have the central rho c (v_{j+1} - v_{j-1}). Both vanish at
-steady state, so the steady state is shared; the transients differ at O(h), the
-order of the discretisation as a whole. Measured on the linearisation of the
+G is upwind, 2 rho c hbar_j (v_j - v_{j-1}) / h_{j-1}, as in the model the Newton
+schemes solve (physics.model), so all schemes share the semi-discretisation. Measured on the linearisation of the
 semi-discrete model at the paper slip steady state (default grid): with the central
 term it is unstable, real parts up to +2.5/s with d = 39/s and +9/s with d = 0
 (friction in the stick zone pumps the rotation modes), and a time-accurate scheme

@@ -74,11 +74,10 @@ def filtered_error(e, a0, mesh, p, w, out):
     for i in range(n):
         j = i + 1
         ul = e[i - 1, 0] if i > 0 else 0.0
-        ur = e[i + 1, 0] if i < n - 1 else 0.0
         tl = e[i - 1, 1] if i > 0 else 0.0
-        tr = e[i + 1, 1] if i < n - 1 else 0.0
-        out[i, 0] = kin * rho * hb[j] * e[i, 0] + a0 * rho * c * (ur - ul)
-        out[i, 1] = kin * I * hb[j] * e[i, 1] + a0 * I * c * (tr - tl)
+        gyro = a0 * 2.0 * c * hb[j] / he[j - 1]
+        out[i, 0] = kin * rho * hb[j] * e[i, 0] + rho * gyro * (e[i, 0] - ul)
+        out[i, 1] = kin * I * hb[j] * e[i, 1] + I * gyro * (e[i, 1] - tl)
         if mesh.j1 < j <= mesh.j2:
             k = he[j - 1] * p.friction_scale * w.sg[j] / p.v_reg * a0
             eb = e[i, 0] + hh * e[i, 1]
