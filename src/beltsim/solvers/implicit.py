@@ -46,7 +46,6 @@ MAX_GROWTH = 2.0  # largest ratio of successive steps (zero-stable below 1 + sqr
 MIN_SHRINK = 0.2
 BDF2_ERROR = 2.0 / 9.0  # leading error constant of BDF2 at a constant step
 NEWTON_CUT = 0.25  # step factor after a failed Newton solve
-FILTER = True
 
 
 class History(NamedTuple):
@@ -157,7 +156,7 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
             for i in range(N - 1):
                 e[i, 0] = err_const * h * h * (au_new[i + 1] - hist.au[i + 1])
                 e[i, 1] = err_const * h * h * (at_new[i + 1] - hist.at[i + 1])
-            if FILTER and filtered_error(e, a0, mesh, p, w, te) or not FILTER:
+            if filtered_error(e, a0, mesh, p, w, te):
                 for i in range(N - 1):
                     err = max(err, abs(e[i, 0]) / scales.u, abs(e[i, 1]) / scales.theta)
             else:
