@@ -40,14 +40,16 @@ def frame_fields(snaps: dict) -> dict:
 def scheme_label(scene) -> str:
     """The scheme and the damping a transient was computed with, for every frame."""
     from .. import solvers
+    from ..solvers.settings import resolve
 
     name = scene.numerics.get("integrator", "implicit")
     kind = "time-accurate" if solvers.get(name).time_accurate else "pseudo-transient path"
     damping = scene.params.damping
     text = f"{name} ({kind}), damping {damping:g} 1/s" if scene.params.inertia else (
         f"{name} ({kind}), quasistatic")
-    if "acceleration" in scene.numerics or name == "pseudo":
-        text += " + numerical acceleration"
+    acceleration = resolve(scene).acceleration
+    if acceleration:
+        text += f" + numerical acceleration {acceleration:.3g} 1/s"
     return text
 
 

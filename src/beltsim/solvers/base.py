@@ -71,6 +71,8 @@ class Scheme:
     transient: ClassVar[bool] = True
     #: whether the path through time is the scene's (to a controlled error), not only the end
     time_accurate: ClassVar[bool] = True
+    #: whether numerics.acceleration (a damping that only speeds the approach) applies
+    accelerated: ClassVar[bool] = False
     needs_inertia: ClassVar[bool] = False
 
     def __init__(self, disc: Discretisation):

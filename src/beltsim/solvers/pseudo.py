@@ -80,6 +80,7 @@ class PseudoScheme(NewtonScheme):
 
     name = "pseudo"
     time_accurate = False
+    accelerated = True
 
     def __init__(self, disc):
         super().__init__(disc)

@@ -47,7 +47,6 @@ DEFAULT_GRADING = 8.0
 # elements do, and keeps the theta error below 2% where 1000 elements did not (h = 0.01 m)
 ELEMENTS_PER_LAYER = 16.0
 DEFAULT_TIME_TOL = 1e-4
-PSEUDO = "pseudo"  # the scheme that may add numerics.acceleration
 MIN_MISMATCH = 1e-8  # smallest nonzero |v/c - 1| a run accepts
 MIN_VREG = 1e-12  # smallest regularisation velocity, relative to c
 
@@ -106,12 +105,14 @@ def resolve(scene: Scene) -> Numerics:
         delta = nm.get("adhesion_layer", 1e-6 * P.L)
         law, vreg = "linear", 1.0
         fs = P.B / (P.c * delta)
-    pseudo = integrator == PSEUDO
-    if "acceleration" in nm and not pseudo:
-        raise SceneError(f'numerics.acceleration: only for numerics.integrator = "{PSEUDO}" '
+    accelerated = registry.get(integrator).accelerated
+    if "acceleration" in nm and not accelerated:
+        allowed = " | ".join(f'"{n}"' for n in registry.names()
+                             if registry.get(n).accelerated)
+        raise SceneError(f"numerics.acceleration: only for numerics.integrator = {allowed} "
                          f"(the damping of a time-accurate run is physics.damping)")
     acceleration = 0.0
-    if pseudo and P.inertia:
+    if accelerated and P.inertia:
         omega1 = math.pi * P.B / (P.L * math.sqrt(P.rho * P.b1))
         acceleration = nm.get("acceleration", 2.0 * omega1)
     return Numerics(
