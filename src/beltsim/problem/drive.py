@@ -36,3 +36,10 @@ def ramp(t, t_ramp):
 def mismatch(drive, t):
     """v(t) - c."""
     return drive.mismatch * ramp(t, drive.ramp_time)
+
+
+def profile_times(scene) -> tuple[float, ...]:
+    """The times of every row of the scene's profile tables, sorted (for marking plots)."""
+    data = scene.to_dict()
+    values = (data["motion"]["surface_speed"], data["contact"].get("max_friction"))
+    return tuple(sorted({float(row[0]) for v in values if isinstance(v, list) for row in v}))
