@@ -3,8 +3,8 @@
 Equations (the paper's, as in beltsim.problem.analytic), B = b1 - rho c^2, A = a - I c^2:
   B eps' + f = 0,  A theta'' - b2 theta + (h/2) f = 0,  eps + (h/2) theta' = e0 in stick,
   theta = 0 at 0 and L, integral of eps = 0, [[B eps]] = -F and [[A theta']] = -(h/2) F at x2.
-Derivatives here are finite differences of the returned u, theta and strain, never the
-solution's own derivative formulas.
+Derivatives here are finite differences (or Chebyshev interpolants) of the returned u, theta
+and strain, never the solution's own derivative formulas.
 """
 
 import math
@@ -202,3 +202,102 @@ def test_full_slip_when_the_limit_is_low():
     s = analytic.solve(paper_scene("slip", ["contact.max_friction=1e4"]))
     assert s.full_slip and s.x_star == s.params.x1
     assert s.total_friction == pytest.approx(1e4 * (s.params.x2 - s.params.x1))
+
+
+# Slip power ------------------------------------------------------------------------------
+# theta' comes from the Chebyshev interpolant of the sampled theta on one smooth segment
+# (theta is a sum of exponentials there, so the interpolant converges spectrally), never
+# from the solution's own derivative formulas.
+
+
+def _theta_prime(sol, a, b, n=64):
+    nodes = np.polynomial.chebyshev.chebpts2(n)
+    x = a + 0.5 * (b - a) * (nodes + 1.0)
+    # theta is continuous at the joints, so the segment's end values need no side
+    fit = np.polynomial.Chebyshev.fit(x, sol.fields(x)["theta"], n - 1, domain=[a, b])
+    return fit.deriv()
+
+
+def _sliding_integral(sol, a, b, epsabs=0.0):
+    """The integral over [a, b] of |f| |eps_b - e0|, eps_b = strain + (h/2) theta'."""
+    P = sol.params
+    dth = _theta_prime(sol, a, b)
+
+    def integrand(x):
+        fl = sol.fields(np.atleast_1d(x))
+        return abs(fl["friction"][0]) * abs(fl["strain"][0] + 0.5 * P.h * dth(x) - P.e0)
+
+    return quad(integrand, a, b, epsabs=epsabs, epsrel=1e-13, limit=500)[0]
+
+
+def _balance_power(sol):
+    """c e0 F_tot + (c/2) [B eps^2 + A theta'^2] from 0 to L, F_tot = B (eps(0) - eps(L))."""
+    P = sol.params
+    eps0 = sol.fields(np.array([0.0]))["strain"][0]
+    epsL = sol.fields(np.array([P.L]), side="left")["strain"][0]
+    dth0 = _theta_prime(sol, 0.0, P.x1)(0.0)
+    dthL = _theta_prime(sol, P.x2, P.L)(P.L)
+    return P.c * (P.e0 * P.B * (eps0 - epsL)
+                  + 0.5 * (P.B * (epsL**2 - eps0**2) + P.A * (dthL**2 - dth0**2)))
+
+
+def _stick_power(sol):
+    P = sol.params
+    return 0.5 * P.c * sol.concentrated_force**2 * (1 / P.B + P.h**2 / (4 * P.A))
+
+
+SLIP_SCENES = {
+    "paper": [],
+    "reversed": ["motion.surface_speed=119.9"],  # belt at 120 m/s: e0 < 0, short slip zone
+    "full_slip": ["contact.max_friction=1e4"],
+}
+
+
+@pytest.mark.parametrize("name", SLIP_SCENES)
+def test_slip_power_is_the_integral_of_the_sliding_power(name):
+    sol = analytic.solve(paper_scene("slip", SLIP_SCENES[name]))
+    P = sol.params
+    assert sol.full_slip == (name == "full_slip")
+    assert (P.e0 < 0) == (name == "reversed")
+    power = P.c * _sliding_integral(sol, sol.x_star, P.x2)
+    assert sol.slip_power > 0
+    assert sol.slip_power == pytest.approx(power, rel=1e-8)
+    assert sol.summary()["slip_power"] == sol.slip_power
+    # the global balance of the steady equations accounts for all of it
+    assert sol.slip_power == pytest.approx(_balance_power(sol), rel=1e-8)
+
+
+@pytest.mark.parametrize("name", ["quasistatic", "inertia", "slip"])
+def test_adhesion_dissipates_only_at_the_concentrated_force(name):
+    sol = analytic.solve(paper_scene(name), model="stick")
+    P = sol.params
+    assert sol.slip_power == pytest.approx(_stick_power(sol), rel=1e-12)
+    assert sol.summary()["slip_power"] == sol.slip_power > 0
+    # no sliding where the distributed traction acts (the integrand is round-off)
+    tol = 1e-9 * sol.slip_power
+    assert P.c * _sliding_integral(sol, P.x1, P.x2, epsabs=0.1 * tol / P.c) <= tol
+    # the jump at x2 dissipates what the global balance says is missing
+    assert sol.slip_power == pytest.approx(_balance_power(sol), rel=1e-8)
+
+
+def test_slip_power_tends_to_the_adhesion_value_as_the_limit_grows():
+    stick = analytic.solve(paper_scene("slip"), model="stick").slip_power
+    prev = math.inf
+    gaps = {}
+    for fs in (1e5, 1e6, 1e7, 1e8, 1e9):
+        sol = analytic.solve(paper_scene("slip", [f"contact.max_friction={fs}"]))
+        gaps[fs] = stick - sol.slip_power
+        assert 0 < gaps[fs] < prev
+        prev = gaps[fs]
+    # the gap shrinks like 1/f*, as the slip zone's width F/f*
+    assert gaps[1e9] * 1e9 == pytest.approx(gaps[1e8] * 1e8, rel=1e-2)
+    assert gaps[1e9] < 1e-5 * stick
+
+
+def test_slip_power_of_the_zero_state_and_under_reversal():
+    for model in ("stick", "slip"):
+        zero = analytic.solve(paper_scene("slip", ["motion.surface_speed=120"]), model=model)
+        assert zero.slip_power == 0.0
+        fwd = analytic.solve(paper_scene("slip", ["motion.surface_speed=121.2"]), model=model)
+        back = analytic.solve(paper_scene("slip", ["motion.surface_speed=118.8"]), model=model)
+        assert back.slip_power == pytest.approx(fwd.slip_power, rel=1e-12)

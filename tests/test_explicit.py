@@ -265,7 +265,7 @@ def test_explicit_step_matches_numpy_twin(name):
     va, wa, db = (1e-2 * rng.standard_normal(n) for _ in range(3))
     for a in (u, th, va, wa):
         a[[0, -1]] = 0.0
-    t = 0.5 * d.drive.ramp_time  # mid-ramp: the drive changes over the step
+    t = 0.5 * d.numerics.ramp_time  # mid-ramp: the drive changes over the step
     ref = _explicit_step_numpy(d, u, th, va, wa, db, t, dt)
     state = State(u.copy(), th.copy(), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n))
     hist = History(va.copy(), wa.copy(), db.copy())

@@ -14,9 +14,10 @@ from helpers import scene_path
 
 # The acceptance bounds (independent of the code): relative errors of the
 # total friction 0.5%, of u and theta 2% (max over the grid, relative to the field's
-# max), of the concentrated force 5%; slip start within 5 mm.
+# max), of the concentrated force 5%; slip start within 5 mm; slip power 1% (the drive
+# issue's bound; its steady-balance reading inherits the total friction's error).
 BOUNDS = {"total_friction": 5e-3, "u": 2e-2, "theta": 2e-2, "concentrated_force": 5e-2,
-          "slip_start": 5e-3}
+          "slip_start": 5e-3, "slip_power": 1e-2}
 # 500 elements keeps each run near 30 ms; the first-order errors there are about half
 # of the default grid's (1000), which meets the bounds with margin on the paper scenes.
 COARSE = "numerics.elements=500"
@@ -160,7 +161,7 @@ def test_cli_run_writes_outputs(tmp_path):
     assert np.all(np.isfinite(np.column_stack(list(fields.values()))))
     hist = read_csv(out / "history.csv")
     assert list(hist) == ["t", "total_friction", "rate", "slip_start", "stick_friction",
-                          "slip_friction"] and len(hist["t"]) > 3
+                          "slip_friction", "slip_power"] and len(hist["t"]) > 3
     # the split adds up, and the slip start lies in the contact
     np.testing.assert_allclose(hist["stick_friction"] + hist["slip_friction"],
                                hist["total_friction"], rtol=1e-12, atol=1e-9)

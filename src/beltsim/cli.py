@@ -54,7 +54,7 @@ def format_summary(summary: dict, title: str = "") -> str:
     rows = [("model", summary["model"]), ("inertia", str(summary["inertia"]).lower())]
     for key, unit in (("total_friction", "N"), ("concentrated_force", "N"),
                       ("distributed_friction", "N"), ("stick_friction", "N"),
-                      ("slip_friction", "N"), ("slip_start", "m")):
+                      ("slip_friction", "N"), ("slip_start", "m"), ("slip_power", "W")):
         value = summary.get(key)
         if value is not None:
             rows.append((key, f"{value:.6g} {unit}"))
@@ -92,8 +92,8 @@ def cmd_run(args):
     result = sim.run(progress=not args.quiet, raise_on_failure=False, handle_signals=True,
                      checkpoint=out / CHECKPOINT)
     if result.interrupted:
-        write_atomic(out / "scene.toml", sim.scene.to_toml())
-        print(f"beltsim: {result.reason}; checkpoint written, continue with "
+        save_run(result, out, complete=False)
+        print(f"beltsim: {result.reason}; state so far and checkpoint written, continue with "
               f"'beltsim run --resume {out}'", file=sys.stderr)
         return 130
     result.reference = reference_of(sim.scene)
@@ -288,6 +288,14 @@ def cmd_animate(args):
     return 0
 
 
+def cmd_plot(args):
+    from .plots.run import plot_run
+
+    paths = plot_run(args.dir, args.out)
+    print("wrote " + ", ".join(str(p) for p in paths))
+    return 0
+
+
 def _int_list(text, name):
     from .problem.scene import MIN_ELEMENTS
 
@@ -359,6 +367,13 @@ def build_parser():
                    help="simulated seconds between snapshots (default L / (4 c))")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_animate)
+
+    p = sub.add_parser("plot", help="draw a stored run (fields and history, against the "
+                       "analytic steady state) as PNG files")
+    p.add_argument("dir", metavar="DIR", help="output directory of 'beltsim run'")
+    p.add_argument("--out", default=None, metavar="OUTDIR",
+                   help="where to write fields.png and history.png (default DIR)")
+    p.set_defaults(func=cmd_plot)
 
     p = sub.add_parser("sweep", help="run a scene for several values of one key, in "
                        "parallel")

@@ -26,11 +26,13 @@ def write_fields(path, x, fields: dict) -> Path:
     return write_csv(path, FIELDS_HEADER, [x] + [fields[k] for k in FIELDS_HEADER[1:]])
 
 
-def save_run(result, out) -> list[Path]:
+def save_run(result, out, complete: bool = True) -> list[Path]:
     """Write a run's summary.json, fields.csv, history.csv and scene.toml into ``out``.
 
     A failed run writes its summary (converged = false, the reason) and the
-    fields of the last good state, which hold no NaN by construction.
+    fields of the last good state, which hold no NaN by construction. An interrupted
+    run (``complete`` false) writes all but the summary: its state so far can be
+    looked at, and the missing summary says it is not finished.
     """
     out = prepare_outdir(out)
     sol = result.solution
@@ -43,7 +45,8 @@ def save_run(result, out) -> list[Path]:
     if result.snapshots:
         paths.append(write_snapshots(out / SNAPSHOTS, result))
     # the summary last: its presence means the other files are complete
-    paths.append(write_json(out / "summary.json", result.summary()))
+    if complete:
+        paths.append(write_json(out / "summary.json", result.summary()))
     return paths
 
 

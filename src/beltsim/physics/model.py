@@ -33,7 +33,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..problem.drive import mismatch
+from ..problem.drive import friction_factor, mismatch
 from .friction import LINEAR, has_dual, law, law_inverse, law_numpy
 
 # |lam| bound in the primal-dual iteration: the friction of a fully sliding node is
@@ -178,7 +178,8 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
     N = u.shape[0] - 1
     B, A, b2 = p.tension_eff, p.bending_eff, p.shear
     rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
-    damp, fs, vreg = p.damping, p.friction_scale, p.v_reg
+    damp, vreg = p.damping, p.v_reg
+    fs = p.friction_scale * friction_factor(drive, t)
     he, hb, j1, j2 = mesh.he, mesh.hb, mesh.j1, mesh.j2
     uo, tho, udo, tdo = old.u, old.theta, old.ud, old.td
     R, Lb, Db, Ub, rl, sg = w.R, w.Lb, w.Db, w.Ub, w.rl, w.sg
@@ -408,7 +409,7 @@ def forces_numpy(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, loads=None
     F = np.zeros_like(u)
     j = np.arange(mesh.j1 + 1, mesh.j2 + 1)
     vrel = ud[j] + hh * td[j] + c * (ub[j] - ub[j - 1]) / he[j - 1] - mismatch(drive, t)
-    F[j] = -he[j - 1] * p.friction_scale * law_numpy(p.law, vrel / p.v_reg)[0]
+    F[j] = -he[j - 1] * p.friction_scale * friction_factor(drive, t) * law_numpy(p.law, vrel / p.v_reg)[0]
     sl = slice(1, -1)
     gyro = 2.0 * c * hb[sl] / he[:-1]
     fu = (B * np.diff(np.diff(u) / he) - rho * gyro * (ud[sl] - ud[:-2])

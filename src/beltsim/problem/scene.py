@@ -67,7 +67,83 @@ class _Rule:
                 opts = " | ".join(f'"{c}"' for c in self.choices)
                 raise SceneError(f"{key}: must be one of {opts}, got {_show(value)}")
             return value
+        if self.kind == "profile":
+            return _check_profile(key, value)
         raise AssertionError(self.kind)
+
+
+SINE_KEYS = ("mean", "amplitude", "period")
+
+
+def _number(key, value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SceneError(f"{key}: must be a number, got {_show(value)}")
+    if not math.isfinite(value):
+        raise SceneError(f"{key}: must be finite, got {_show(value)}")
+    return float(value)
+
+
+def _check_profile(key, value):
+    """A positive quantity over time: a number, a table of [time, value] rows, or a sine.
+
+    Tables are interpolated linearly and held before the first and after the last row;
+    a sine is { mean, amplitude, period } (value mean + amplitude sin(2 pi t / period)).
+    """
+    if isinstance(value, dict):
+        for k in value:
+            if k not in SINE_KEYS:
+                raise SceneError(f"{key}.{k}: unknown key of a sine (known: "
+                                 f"{', '.join(SINE_KEYS)})")
+        for k in SINE_KEYS:
+            if k not in value:
+                raise SceneError(f"{key}.{k}: missing key of a sine (a sine is "
+                                 f"{{ mean = ..., amplitude = ..., period = ... }})")
+        out = {k: _number(f"{key}.{k}", value[k]) for k in SINE_KEYS}
+        if not out["period"] > 0:
+            raise SceneError(f"{key}.period: must be > 0, got {out['period']!r}")
+        if not out["mean"] - abs(out["amplitude"]) > 0:
+            raise SceneError(f"{key}: must stay > 0, got mean - |amplitude| = "
+                             f"{out['mean'] - abs(out['amplitude'])!r}")
+        return out
+    if isinstance(value, list):
+        if not value:
+            raise SceneError(f"{key}: a table needs at least one [time, value] row")
+        rows = []
+        for i, row in enumerate(value, 1):
+            name = f"{key} row {i}"
+            if not isinstance(row, list) or len(row) != 2:
+                raise SceneError(f"{name}: must be a [time, value] pair, got {_show(row)}")
+            t, v = _number(f"{name} time", row[0]), _number(f"{name} value", row[1])
+            if rows and not t > rows[-1][0]:
+                raise SceneError(f"{name}: times must increase strictly, got {t!r} after "
+                                 f"{rows[-1][0]!r}")
+            if not v > 0:
+                raise SceneError(f"{name} value: must be > 0, got {v!r}")
+            rows.append([t, v])
+        return rows
+    value = _number(key, value)
+    if not value > 0:
+        raise SceneError(f"{key}: must be > 0, got {value!r}")
+    return value
+
+
+def final_value(value) -> float:
+    """The value a profile settles on: the number, the last row, or a sine's mean."""
+    if isinstance(value, list):
+        return value[-1][1]
+    if isinstance(value, dict):
+        return value["mean"]
+    return value
+
+
+def profile_extremes(value) -> tuple[float, float]:
+    """The smallest and largest value a profile takes."""
+    if isinstance(value, list):
+        vals = [row[1] for row in value]
+        return min(vals), max(vals)
+    if isinstance(value, dict):
+        return value["mean"] - abs(value["amplitude"]), value["mean"] + abs(value["amplitude"])
+    return value, value
 
 
 def _show(value):
@@ -83,6 +159,7 @@ def _show(value):
 
 
 POS = _Rule("float", positive=True)
+PROFILE = _Rule("profile")
 #: The fewest elements of a grid: two in each of [0, x1], [x1, x2], [x2, L].
 MIN_ELEMENTS = 6
 
@@ -97,12 +174,12 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "density": POS,
         "shear_factor": POS,
     },
-    "motion": {"belt_speed": POS, "surface_speed": POS},
+    "motion": {"belt_speed": POS, "surface_speed": PROFILE},
     "contact": {
         "start": _Rule("float"),
         "end": _Rule("float"),
         "friction": _Rule("str", choices=("stick", "coulomb")),
-        "max_friction": POS,
+        "max_friction": PROFILE,
     },
     "physics": {"inertia": _Rule("bool"), "damping": _Rule("float", nonneg=True)},
     "stiffness": {
@@ -240,6 +317,21 @@ def validate(data: dict) -> dict:
         raise SceneError(
             f"motion.belt_speed: must stay below both critical speeds, "
             f"sqrt(b1/rho) = {c_t:.6g} m/s and sqrt(a/I) = {c_b:.6g} m/s, got {P.c!r} m/s")
+    speed = out["motion"]["surface_speed"]
+    if P.inertia and not isinstance(speed, float):
+        top, crit = profile_extremes(speed)[1], min(P.critical_speeds)
+        if top >= crit:
+            raise SceneError(f"motion.surface_speed: every speed of the profile must stay "
+                             f"below both critical speeds (the lower is {crit:.6g} m/s), "
+                             f"got {top!r} m/s")
+    periods = {k: v["period"] for k, v in (("motion.surface_speed", speed),
+               ("contact.max_friction", out["contact"].get("max_friction")))
+               if isinstance(v, dict)}
+    if len(set(periods.values())) > 1:
+        raise SceneError("contact.max_friction.period: must equal motion.surface_speed.period "
+                         "(a run has one periodic steady state), got "
+                         f"{periods['contact.max_friction']!r} and "
+                         f"{periods['motion.surface_speed']!r}")
     return out
 
 
@@ -282,7 +374,7 @@ class Params:
     x1: float
     x2: float
     c: float
-    v: float
+    v: float  # the surface speed the drive settles on (a profile's final value)
     a: float
     b1: float
     b2: float
@@ -290,7 +382,7 @@ class Params:
     I: float
     inertia: bool
     friction: str
-    fstar: float | None
+    fstar: float | None  # the friction limit the drive settles on (final value)
     damping: float = 0.0  # d (1/s) of the viscous damping d rho u_t, d I theta_t
 
     @property
@@ -322,10 +414,10 @@ def _params(d: dict) -> Params:
     return Params(
         L=d["beam"]["length"], h=d["beam"]["height"],
         x1=contact["start"], x2=contact["end"],
-        c=d["motion"]["belt_speed"], v=d["motion"]["surface_speed"],
+        c=d["motion"]["belt_speed"], v=final_value(d["motion"]["surface_speed"]),
         a=p["a"], b1=p["b1"], b2=p["b2"], rho=p["rho"], I=p["I"],
         inertia=d["physics"]["inertia"], friction=contact["friction"],
-        fstar=contact.get("max_friction"),
+        fstar=(final_value(contact["max_friction"]) if "max_friction" in contact else None),
         damping=d["physics"].get("damping", 0.0) if d["physics"]["inertia"] else 0.0,
     )
 
@@ -409,6 +501,10 @@ class Scene:
 
 
 def _toml_value(value) -> str:
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items()) + " }"
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):

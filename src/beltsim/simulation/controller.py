@@ -9,6 +9,7 @@ failure the state goes back to the last good check, so a failed run never holds 
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -16,6 +17,8 @@ import numpy as np
 from .. import solvers
 from ..errors import NumericalError
 from ..physics.grid import Grid
+from ..problem.drive import mismatch as mismatch_at
+from ..problem.drive import period_of, profile_times
 from ..problem.scene import Scene
 from .result import RunResult, RunStatus
 from .solution import DiscreteSolution
@@ -27,12 +30,14 @@ from .trackers import (
     PowerBalanceTracker,
     ProgressTracker,
     SignalTracker,
+    PeriodicTracker,
     SnapshotTracker,
     SteadyStateTracker,
     Tracker,
 )
 
 CHECKS_PER_TRANSIT = 4  # checks per transit time L / c
+CHECKS_PER_PERIOD = 32  # at least, for a periodic drive (its extremes are read at checks)
 
 
 class Simulation:
@@ -57,8 +62,18 @@ class Simulation:
         if self.snapshot_interval:
             self.check = min(self.check, self.snapshot_interval)
         self.history = HistoryTracker("stick" if self.params.friction == "stick" else "slip")
-        self.steady = SteadyStateTracker(num.steady_tol, window, num.ramp_time,
-                                         P.B * self.disc.scales.theta * 1e-3)
+        friction_scale = P.B * self.disc.scales.theta * 1e-3
+        period = period_of(scene)
+        if period is None:
+            self.steady = SteadyStateTracker(num.steady_tol, window, num.settle_time,
+                                             friction_scale)
+        else:  # checks at equal phases of the period
+            samples = max(CHECKS_PER_PERIOD, math.ceil(period / self.check))
+            self.check = period / samples
+            self.steady = PeriodicTracker(num.steady_tol, period, samples, num.settle_time,
+                                          friction_scale, P.L, self.history.model)
+        # chunks end on the drive's table rows, where its rate jumps
+        self.breaks = np.array(profile_times(scene))
         self.snapshots = (SnapshotTracker(self.snapshot_interval) if self.snapshot_interval
                           else None)
         self.power = PowerBalanceTracker() if hasattr(self.scheme, "work_integrals") else None
@@ -102,9 +117,11 @@ class Simulation:
 
     def solution(self) -> DiscreteSolution:
         n = self.numerics
+        # a steady solve's state is the final drive's, whatever the clock says
+        mismatch = mismatch_at(self.disc.drive, self.t) if self.scheme.transient else None
         return DiscreteSolution(self.params, self.grid, self.state.u, self.state.theta,
                                 self.state.fnode, n.law_code, n.fs, self.state.ud,
-                                self.state.td)
+                                self.state.td, mismatch)
 
     # stepping ---------------------------------------------------------
     def warm_up(self) -> float:
@@ -159,6 +176,10 @@ class Simulation:
                 good = (self.state.copy(), self.t, self.scheme.checkpoint())
                 try:
                     t_next = self.t + self.check
+                    k = np.searchsorted(self.breaks, self.t * (1 + 1e-12) + 1e-300,
+                                        side="right")
+                    if k < self.breaks.size and self.breaks[k] < t_next - 1e-9 * self.check:
+                        t_next = self.breaks[k]
                     # the last chunk absorbs a round-off remainder rather than leave a sliver
                     self.advance(t_end if t_next > t_end - 1e-9 * self.check else t_next)
                     stop = None
@@ -213,6 +234,8 @@ class Simulation:
             compile_time=compile_time, statistics=self.scheme.statistics(),
             history=self.history.arrays(),
             power_balance=self.power.balance(self) if self.power is not None else None,
+            periodic=(self.steady.last_period()
+                      if isinstance(self.steady, PeriodicTracker) else None),
             snapshots=self.snapshots.arrays() if self.snapshots is not None else {})
 
     # checkpoints ------------------------------------------------------

@@ -34,6 +34,8 @@ class RunResult:
     snapshots: dict = field(default_factory=dict)
     #: E(t) - E(0) against the integrated power terms (schemes that integrate them)
     power_balance: dict | None = None
+    #: a periodic drive's last period: extremes and means (None for a drive that settles)
+    periodic: dict | None = None
     #: the exact steady solution of the same scene, attached by the caller (None: not
     #: attached, or the scene has none)
     reference: analytic.AnalyticSolution | None = None
@@ -71,6 +73,7 @@ class RunResult:
                    compile_time=self.compile_time,
                    reason=self.reason, elements=self.numerics.elements,
                    integrator=self.numerics.integrator, power_balance=self.power_balance,
+                   periodic=self.periodic,
                    error=self.errors())
         return out
 

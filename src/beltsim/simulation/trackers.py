@@ -69,21 +69,27 @@ class DivergenceGuard(Tracker):
 class HistoryTracker(Tracker):
     """At every check: t, total friction, the largest local rate, and the friction split.
 
-    Coulomb scenes add the slip start and the stick and slip parts of the friction,
-    perfect adhesion the concentrated force, read off the state as in the summary.
+    Coulomb scenes add the slip start, the stick and slip parts of the friction and the
+    slip power (the friction law's dissipation at that moment), perfect adhesion the
+    concentrated force, read off the state as in the summary.
     """
 
     name = "history"
     BASE = ("t", "total_friction", "rate")
-    SPLIT = {"slip": ("slip_start", "stick_friction", "slip_friction"),
+    SPLIT = {"slip": ("slip_start", "stick_friction", "slip_friction", "slip_power"),
              "stick": ("concentrated_force",)}
 
     def __init__(self, model: str):
+        self.model = model
         self.keys = self.BASE + self.SPLIT[model]
         self.data = {k: [] for k in self.keys}
 
     def handle(self, sim):
-        summary = sim.solution().summary()
+        sol = sim.solution()
+        summary = sol.summary()
+        # on the path, the friction law's dissipation now (the summary's steady balance
+        # holds only at a steady state)
+        summary["slip_power"] = sol.slip_power
         self.data["t"].append(sim.t)
         self.data["rate"].append(sim.rate())
         for k in self.keys:
@@ -154,6 +160,68 @@ class SteadyStateTracker(Tracker):
         count, self.change, self.rate = data["scalars"]
         self._count = int(count)
         self._hist = deque(map(tuple, data["window"]))
+
+
+class PeriodicTracker(Tracker):
+    """A periodic steady state of a periodic drive.
+
+    The checks fall at ``samples`` equal phases of each period; after ``t_min`` (the
+    ramp) the total friction and the history's second quantity (slip start, or the
+    concentrated force) of the last period are compared, phase by phase, with the
+    period before: periodic when the largest change is below ``tol`` (relative to the
+    friction, and to L for the slip start) at ``hold`` checks in a row.
+    """
+
+    name = "steady"
+
+    def __init__(self, tol: float, period: float, samples: int, t_min: float,
+                 friction_scale: float, length: float, model: str, hold: int = 3):
+        self.tol, self.period, self.samples, self.t_min = tol, period, samples, t_min
+        self.second = "slip_start" if model == "slip" else "concentrated_force"
+        self.friction_scale, self.length, self.hold = friction_scale, length, hold
+        self._rows: deque = deque(maxlen=2 * samples)
+        self._count = 0
+        self.change = math.inf
+
+    def handle(self, sim):
+        h = sim.history.data
+        if sim.t < self.t_min:
+            return None
+        self._rows.append((sim.t, h["total_friction"][-1], h[self.second][-1]))
+        if len(self._rows) < 2 * self.samples:
+            return None
+        rows = np.array(self._rows)
+        old, new = rows[: self.samples], rows[self.samples:]
+        scale = max(np.abs(new[:, 1]).max(), self.friction_scale)
+        second_scale = self.length if self.second == "slip_start" else scale
+        self.change = max(np.abs(new[:, 1] - old[:, 1]).max() / scale,
+                          np.abs(new[:, 2] - old[:, 2]).max() / second_scale)
+        self._count = self._count + 1 if self.change < self.tol else 0
+        return Stop(RunStatus.CONVERGED) if self._count >= self.hold else None
+
+    def last_period(self) -> dict | None:
+        """Minimum, maximum and mean over the last period of the two compared quantities."""
+        if len(self._rows) < self.samples:
+            return None
+        rows = np.array(self._rows)[-self.samples:]
+        out = {"period": self.period, "change": self.change}
+        for col, key in ((1, "total_friction"), (2, self.second)):
+            out[key] = {"min": float(rows[:, col].min()), "max": float(rows[:, col].max()),
+                        "mean": float(rows[:, col].mean())}  # equal phases: exact for a sine
+        return out
+
+    def not_steady(self, t_end: float) -> str:
+        return (f"no periodic steady state by t_end = {t_end:.6g} s (change between the "
+                f"last two periods {self.change:.3g}; tolerance {self.tol:.3g})")
+
+    def state(self):
+        return {"scalars": np.array([self._count, self.change]),
+                "rows": np.array(list(self._rows)).reshape(-1, 3)}
+
+    def restore(self, data):
+        count, self.change = data["scalars"]
+        self._count = int(count)
+        self._rows = deque(map(tuple, data["rows"]), maxlen=2 * self.samples)
 
 
 class SnapshotTracker(Tracker):

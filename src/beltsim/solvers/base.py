@@ -9,7 +9,7 @@ import numpy as np
 
 from ..physics.grid import Grid
 from ..physics.model import Loads, Mesh, ModelParams, State, mesh_of, model_params
-from ..problem.drive import Drive
+from ..problem.drive import drive_of
 from ..problem.scene import Scene
 from .settings import Numerics, build_grid, resolve
 
@@ -50,7 +50,7 @@ class Discretisation:
         self.mesh: Mesh = mesh_of(self.grid)
         self.model: ModelParams = model_params(P, P.damping + num.acceleration, num.fs, num.vreg,
                                                num.law_code)
-        self.drive = Drive(P.v - P.c, num.ramp_time)
+        self.drive = drive_of(scene, num.ramp_time)
         self.loads: Loads = Loads.none(self.grid.n_elements + 1)
         self.scales: Scales = scales_of(P)
 

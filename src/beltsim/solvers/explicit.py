@@ -70,7 +70,7 @@ from numba import njit
 from ..errors import SceneError
 from ..physics.friction import LINEAR, RAMP, SQRT, TANH, law
 from ..physics.model import hermite_weights, load_at
-from ..problem.drive import mismatch
+from ..problem.drive import friction_factor, mismatch
 from .base import Scheme
 from .registry import register
 
@@ -199,12 +199,12 @@ def coefficients(dt, mesh, p):
 
 
 @njit(cache=True, fastmath=SAFE_FASTMATH)
-def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, co, mesh, p):
+def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, ff, co, mesh, p):
     """The kick's friction at the contact nodes, in the direction of the flow.
 
     On entry va, wa hold the kick without friction, bb the bottom-fibre velocity
     before the kick and eb its increment without friction; db the previous kick's
-    bottom increments, replaced by this kick's.
+    bottom increments, replaced by this kick's. ff: f*(t) / f* of the drive.
     """
     j1, j2, hh, code, ivreg = mesh.j1, mesh.j2, p.half_height, p.law, 1.0 / p.v_reg
     smooth = code == TANH or code == SQRT
@@ -220,7 +220,7 @@ def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, co, mesh, p):
         # from node to node is then a few multiplications, while the law's exp and
         # the divisions of successive nodes overlap. It converges in ~95% of the
         # node-steps; the rest, and an s0 outside the bracket, go to the full solve.
-        s0, kap = sfr[j], co.kap[j]
+        s0, kap = sfr[j], co.kap[j] * ff
         if code == TANH:
             e = math.exp(-2.0 * abs(s0))
             g0 = math.copysign((1.0 - e) / (1.0 + e), s0)
@@ -240,7 +240,7 @@ def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, co, mesh, p):
             s, g = s0 + ds, g0 + gp * ds
         else:
             s, g = _friction_scalar(code, sp, kap, s0)
-        F = -co.fh[j] * g
+        F = -co.fh[j] * ff * g
         va[j] += co.fm[j] * F
         wa[j] += co.fi[j] * F
         d = eb[j] + co.kb[j] * F
@@ -312,7 +312,8 @@ def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, driv
             _kick_from(u, th, va, wa, yv if rep else ud, yw if rep else td, bb, eb, co,
                        spring, hh)
             _add_loads(va, wa, eb, t, dt, p, loads)
-            _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, co, mesh, p)
+            _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target,
+                           friction_factor(drive, t), co, mesh, p)
             for j in range(1, N):  # u_t - delta / 2
                 yv[j] = 1.5 * ud[j] - 0.5 * va[j]
                 yw[j] = 1.5 * td[j] - 0.5 * wa[j]
@@ -350,8 +351,8 @@ def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, driv
         t += dt
         steps += 1
         _add_loads(va, wa, eb, t, dt, p, loads)
-        _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, mismatch(drive, t), co, mesh,
-                       p)
+        _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, mismatch(drive, t),
+                       friction_factor(drive, t), co, mesh, p)
         if last:
             for j in range(1, N):
                 ud[j] = 0.5 * (ud[j] + va[j])

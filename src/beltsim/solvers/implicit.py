@@ -38,6 +38,7 @@ import numpy as np
 from numba import njit
 
 from ..physics.model import POWER_TERMS, block_solve, power_terms
+from ..problem.drive import friction_factor
 from .newton import FAILED, NONFINITE, OK, NewtonScheme, newton
 from .registry import register
 
@@ -64,8 +65,11 @@ class History(NamedTuple):
 
 
 @njit(cache=True)
-def filtered_error(e, a0, mesh, p, w, out):
-    """Solve J e_f = T e in place of ``e`` (n, 2); J: w's blocks, T: their a0 part."""
+def filtered_error(e, a0, fs, mesh, p, w, out):
+    """Solve J e_f = T e in place of ``e`` (n, 2); J: w's blocks, T: their a0 part.
+
+    fs: the friction scale at the step's time (f* times the profile's factor).
+    """
     n = e.shape[0]
     rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
     kin = a0 * a0 + p.damping * a0
@@ -78,7 +82,7 @@ def filtered_error(e, a0, mesh, p, w, out):
         out[i, 0] = kin * rho * hb[j] * e[i, 0] + rho * gyro * (e[i, 0] - ul)
         out[i, 1] = kin * I * hb[j] * e[i, 1] + I * gyro * (e[i, 1] - tl)
         if mesh.j1 < j <= mesh.j2:
-            k = he[j - 1] * p.friction_scale * w.sg[j] / p.v_reg * a0
+            k = he[j - 1] * fs * w.sg[j] / p.v_reg * a0
             eb = e[i, 0] + hh * e[i, 1]
             out[i, 0] += k * eb
             out[i, 1] += hh * k * eb
@@ -156,7 +160,8 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
             for i in range(N - 1):
                 e[i, 0] = err_const * h * h * (au_new[i + 1] - hist.au[i + 1])
                 e[i, 1] = err_const * h * h * (at_new[i + 1] - hist.at[i + 1])
-            if filtered_error(e, a0, mesh, p, w, te):
+            if filtered_error(e, a0, p.friction_scale * friction_factor(drive, t + h), mesh, p, w,
+                              te):
                 for i in range(N - 1):
                     err = max(err, abs(e[i, 0]) / scales.u, abs(e[i, 1]) / scales.theta)
             else:

@@ -5,11 +5,13 @@ Defaults (all overridable in [numerics]):
 * ``elements`` max(1000, 16 L max(alpha, beta)): 1000, or more where theta decays
   over a shorter length than the paper's 17 mm; ``grading`` 8 (smallest element at
   x2, largest 8x bigger);
-* ``ramp_time`` 2 L / c: the surface speed goes smoothly from c to v;
-* ``dt`` ramp_time / 50;
-* ``t_end`` ramp_time + 400 L / c (a run that has not settled by then stops
-  with converged = false);
-* ``regularisation`` (coulomb) v_reg = 1e-4 |v - c|: the creep velocity in
+* ``ramp_time`` 2 L / c: the surface speed goes smoothly from c to v (a number or a
+  sine; a table sets its own times, :mod:`beltsim.problem.drive`);
+* ``dt`` max(ramp_time, L / c) / 50;
+* ``t_end`` T + 400 L / c, T the end of the drive's changes (the ramp, the last row of
+  every table); a run that has not settled by then stops with converged = false;
+* ``regularisation`` (coulomb) v_reg = 1e-4 |v - c|, v the final surface speed (the
+  largest |v(t) - c| of the profile when that is 0 or the drive is periodic): the creep velocity in
   stick zones is then ~1e-4 of the imposed one and the layer
   (b1 - rho c^2) v_reg / (c f*) that replaces the jump at x* is far below an
   element, so the regularisation error stays well below the grid's;
@@ -37,6 +39,7 @@ from ..errors import SceneError
 from ..physics.friction import LAW_CODES
 from ..physics.grid import Grid, make_grid
 from ..problem.analytic import decay_rates
+from ..problem.drive import largest_mismatch, period_of, profile_times, speed_ramped
 from ..problem.scene import Params, Scene
 from . import registry
 
@@ -68,6 +71,7 @@ class Numerics:
     newton_tol: float = 1e-9
     newton_max_it: int = 30
     time_tol: float = DEFAULT_TIME_TOL
+    settle_time: float = 0.0  # when the drive stops changing (steady tests start there)
 
     @property
     def law_code(self) -> int:
@@ -80,7 +84,7 @@ def resolve(scene: Scene) -> Numerics:
     transit = P.L / P.c
     ramp_time = nm.get("ramp_time", 2.0 * transit)
     dt = nm.get("dt", max(ramp_time, transit) / 50.0)
-    t_end = nm.get("t_end", ramp_time + 400.0 * transit)
+    t_end = nm.get("t_end", settle_time(scene, ramp_time) + 400.0 * transit)
     if dt > t_end:
         raise SceneError(f"numerics.dt: must be <= numerics.t_end = {t_end!r}, got {dt!r}")
     integrator = nm.get("integrator", "implicit")
@@ -95,6 +99,8 @@ def resolve(scene: Scene) -> Numerics:
             f"for the zero state")
     if P.friction == "coulomb":
         dv = abs(P.v - P.c)
+        if dv == 0.0 or period_of(scene) is not None:
+            dv = largest_mismatch(scene)
         vreg = nm.get("regularisation", 1e-4 * dv if dv > 0 else 1e-6 * P.c)
         law, fs = nm.get("friction_law", "tanh"), P.fstar
         if vreg < MIN_VREG * P.c:
@@ -125,7 +131,15 @@ def resolve(scene: Scene) -> Numerics:
         newton_tol=nm.get("newton_tol", 1e-9),
         newton_max_it=nm.get("newton_max_iterations", 30),
         time_tol=nm.get("time_tol", DEFAULT_TIME_TOL),
+        settle_time=settle_time(scene, ramp_time),
     )
+
+
+def settle_time(scene: Scene, ramp_time: float) -> float:
+    """When the drive stops changing (for a periodic drive, when its ramp ends): the
+    steady-state test starts there."""
+    times = profile_times(scene)
+    return max(ramp_time if speed_ramped(scene) else 0.0, times[-1] if times else 0.0)
 
 
 def default_elements(P: Params) -> int:

@@ -27,7 +27,7 @@ class SteadyScheme(NewtonScheme):
 
     def _stage(self, state, s, settings):
         d = self.disc
-        drive = Drive(d.drive.mismatch * s, 0.0)
+        drive = Drive.constant((d.params.v - d.params.c) * s)
         return newton(state, self.old, 0.0, 0.0, d.mesh, d.model, drive, d.loads, d.scales,
                       settings, self.work)
 
