@@ -6,6 +6,7 @@ import enum
 from dataclasses import dataclass, field
 
 from ..problem import analytic
+from ..problem.drive import period_of
 from ..problem.scene import Scene
 from ..solvers.settings import Numerics
 from .solution import DiscreteSolution, compare
@@ -79,7 +80,10 @@ class RunResult:
 
 
 def reference_of(scene: Scene, model: str | None = None):
-    """The exact steady solution of a scene, or None where it has none."""
+    """The exact steady solution of a scene, or None where it has none (a periodic drive
+    never settles)."""
+    if period_of(scene) is not None:
+        return None
     try:
         return analytic.solve(scene, model=model)
     except analytic.NoSolutionError:

@@ -204,7 +204,7 @@ class PeriodicTracker(Tracker):
         if len(self._rows) < self.samples:
             return None
         rows = np.array(self._rows)[-self.samples:]
-        out = {"period": self.period, "change": self.change}
+        out = {"period": self.period, "change": float(self.change)}
         for col, key in ((1, "total_friction"), (2, self.second)):
             out[key] = {"min": float(rows[:, col].min()), "max": float(rows[:, col].max()),
                         "mean": float(rows[:, col].mean())}  # equal phases: exact for a sine
