@@ -115,6 +115,12 @@ def format_run(summary: dict) -> str:
     lines = [f"  converged       {str(summary['converged']).lower()} after "
              f"{summary['steps']} steps, t = {summary['simulated_time']:.4g} s, "
              f"wall {summary['wall_time']:.3g} s"]
+    per = summary.get("periodic")
+    if per:
+        for key, part in per.items():
+            if isinstance(part, dict):
+                lines.append(f"  last period     {key} min {part['min']:.6g}, mean "
+                             f"{part['mean']:.6g}, max {part['max']:.6g}")
     err = summary.get("error")
     if err:
         parts = [f"{k} {v:.2e}" for k, v in err.items() if v is not None]

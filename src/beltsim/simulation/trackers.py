@@ -178,6 +178,9 @@ class PeriodicTracker(Tracker):
                  friction_scale: float, length: float, model: str, hold: int = 3):
         self.tol, self.period, self.samples, self.t_min = tol, period, samples, t_min
         self.second = "slip_start" if model == "slip" else "concentrated_force"
+        # reported over the last period; the first two are compared between periods
+        self.keys = ("total_friction", self.second) + (("slip_power",) if model == "slip"
+                                                       else ())
         self.friction_scale, self.length, self.hold = friction_scale, length, hold
         self._rows: deque = deque(maxlen=2 * samples)
         self._count = 0
@@ -187,7 +190,7 @@ class PeriodicTracker(Tracker):
         h = sim.history.data
         if sim.t < self.t_min:
             return None
-        self._rows.append((sim.t, h["total_friction"][-1], h[self.second][-1]))
+        self._rows.append((sim.t, *(h[k][-1] for k in self.keys)))
         if len(self._rows) < 2 * self.samples:
             return None
         rows = np.array(self._rows)
@@ -200,12 +203,12 @@ class PeriodicTracker(Tracker):
         return Stop(RunStatus.CONVERGED) if self._count >= self.hold else None
 
     def last_period(self) -> dict | None:
-        """Minimum, maximum and mean over the last period of the two compared quantities."""
+        """Minimum, maximum and mean over the last period of the quantities in ``keys``."""
         if len(self._rows) < self.samples:
             return None
         rows = np.array(self._rows)[-self.samples:]
         out = {"period": self.period, "change": float(self.change)}
-        for col, key in ((1, "total_friction"), (2, self.second)):
+        for col, key in enumerate(self.keys, 1):
             out[key] = {"min": float(rows[:, col].min()), "max": float(rows[:, col].max()),
                         "mean": float(rows[:, col].mean())}  # equal phases: exact for a sine
         return out
@@ -216,7 +219,7 @@ class PeriodicTracker(Tracker):
 
     def state(self):
         return {"scalars": np.array([self._count, self.change]),
-                "rows": np.array(list(self._rows)).reshape(-1, 3)}
+                "rows": np.array(list(self._rows)).reshape(-1, 1 + len(self.keys))}
 
     def restore(self, data):
         count, self.change = data["scalars"]
