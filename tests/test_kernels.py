@@ -18,10 +18,10 @@ from beltsim.physics.model import (
     Loads,
     State,
     assemble,
-    hermite_weights,
-    load_at,
     block_solve,
     blocks_to_dense,
+    hermite_weights,
+    load_at,
     residual_numpy,
     update_multipliers,
 )

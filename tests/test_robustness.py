@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import beltsim
+from beltsim import solvers
 from beltsim.io.files import read_csv
 from beltsim.io.results import write_checkpoint
-from beltsim import solvers
 from beltsim.simulation.controller import Simulation
 from beltsim.studies.stability import STABILITY_CASES
 from helpers import scene_path

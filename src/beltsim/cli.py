@@ -67,7 +67,7 @@ def format_summary(summary: dict, title: str = "") -> str:
 def cmd_run(args):
     from pathlib import Path
 
-    from .io.files import prepare_outdir, write_atomic
+    from .io.files import prepare_outdir
     from .io.results import CHECKPOINT, save_run
     from .simulation.controller import Simulation
     from .simulation.result import reference_of
