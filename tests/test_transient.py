@@ -188,6 +188,7 @@ def test_steady_limit_is_the_steady_solution(kind):
     (("contact.max_friction=2e4",), "contact.max_friction"),  # slides everywhere in the end
     (("contact.start=0.05", "contact.end=0.9", "numerics.ramp_time=0", "contact.max_friction=5e4"),
      "contact.max_friction"),  # stick traction b1 e0 / x1 = 1e5 N/m at once: above f*
+    (("contact.max_friction=[[0.0, 1e6], [0.1, 5e5]]",), "contact.max_friction"),  # profile
 ])
 def test_scenes_outside_the_limit_are_refused(overrides, key):
     scene = thin_scene("coulomb", *overrides)

@@ -370,6 +370,12 @@ def thin_belt(scene: Scene) -> ThinBeltTransient:
     if P.inertia:
         raise SceneError("physics.inertia: the thin-belt transient needs physics.inertia = "
                          "false (quasistatic), got true")
+    data = scene.to_dict()
+    for key, raw in (("motion.surface_speed", data["motion"]["surface_speed"]),
+                     ("contact.max_friction", data["contact"].get("max_friction", 0.0))):
+        if not isinstance(raw, float):
+            raise SceneError(f"{key}: the thin-belt transient is derived for a number (the "
+                             f"smooth start-up at constant f*), got a profile")
     eta = thin_parameter(P)
     if eta > THIN_TOL:
         raise SceneError(
