@@ -175,7 +175,9 @@ class Simulation:
             while self.t < t_end:
                 good = (self.state.copy(), self.t, self.scheme.checkpoint())
                 try:
-                    t_next = self.t + self.check
+                    # checks on a fixed grid k * check: a scheme that steps past a
+                    # check (explicit, fixed dt) does not drift from it
+                    t_next = self.check * (math.floor(self.t / self.check + 1e-9) + 1)
                     k = np.searchsorted(self.breaks, self.t * (1 + 1e-12) + 1e-300,
                                         side="right")
                     if k < self.breaks.size and self.breaks[k] < t_next - 1e-9 * self.check:
