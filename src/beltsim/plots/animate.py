@@ -17,6 +17,8 @@ import numpy as np
 from ..io.files import OutputError, atomic_path
 from ..io.results import read_snapshots
 from ..problem import analytic
+from ..problem.drive import drive_of, friction_factor, has_profiles, mismatch
+from ..solvers.settings import resolve
 from ..simulation.solution import stress_resultants
 from .common import pyplot
 
@@ -116,13 +118,26 @@ def animate(snapshots_path, out_path, fmt: str = "gif", fps: int = 15) -> Path:
     how = scheme_label(scene)
     fig.suptitle(scene.title or "beltsim transient", fontsize=11)
 
+    # a drive that changes after its start-up names its values on each frame
+    drive = drive_of(scene, resolve(scene).ramp_time)
+    P = scene.params
+    varies = has_profiles(scene)
+
+    def drive_text(t):
+        if not varies:
+            return ""
+        text = f"   v = {P.c + mismatch(drive, t):.4g} m/s"
+        if P.fstar is not None:
+            text += f", f* = {P.fstar * friction_factor(drive, t):.3g} N/m"
+        return text
+
     def draw(k):
         for key, line in lines.items():
             line.set_ydata(fields[key][k])
         f = fields["friction"][k]
         off = np.abs(f) > f_cap
         marks.set_data(x[off], np.sign(f[off]) * f_cap * 0.97)
-        stamp.set_text(f"t = {1e3 * times[k]:.2f} ms   {how}")
+        stamp.set_text(f"t = {1e3 * times[k]:.2f} ms{drive_text(times[k])}   {how}")
         return [*lines.values(), marks, stamp]
 
     out_path = Path(out_path)

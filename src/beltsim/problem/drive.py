@@ -126,6 +126,11 @@ def profile_times(scene) -> tuple[float, ...]:
                          for row in v}))
 
 
+def has_profiles(scene) -> bool:
+    """Whether the drive is more than the start-up ramp (a table or a sine anywhere)."""
+    return any(isinstance(v, (list, dict)) for v in _profiles(scene))
+
+
 def period_of(scene) -> float | None:
     """The period of a periodic drive (a sine), None for a drive that settles."""
     periods = [v["period"] for v in _profiles(scene) if isinstance(v, dict)]
