@@ -16,7 +16,7 @@ from beltsim.io.files import read_csv
 from beltsim.io.results import write_checkpoint
 from beltsim.simulation.controller import Simulation
 from beltsim.studies.stability import STABILITY_CASES
-from helpers import scene_path
+from helpers import cli, scene_path
 
 
 def _scene(*overrides, name="paper_slip"):
@@ -160,3 +160,26 @@ def test_stability_command_quick_matrix(tmp_path):
     outside = any(r["status"] not in ("converged", "bounded", "refused", "not applicable")
                   for r in rows)
     assert proc.returncode == (1 if outside else 0), proc.stderr
+
+
+def test_an_oversized_grid_is_refused_before_it_allocates():
+    """Zeros too many: the grid's memory (600 bytes a node, 56 TiB here) against the
+    machine's."""
+    proc = cli("run", scene_path("paper_slip"), "--set", "numerics.elements=100000000000",
+               "--quiet", "--out", "/nonexistent/never-written")
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+    assert "numerics.elements: 100000000000 elements need about 5.59e+04 GiB" in proc.stderr
+    assert "available" in proc.stderr
+
+
+def test_explicit_work_beyond_max_work_is_refused_with_the_estimate():
+    with pytest.raises(beltsim.SceneError) as info:
+        Simulation(_scene("numerics.integrator=explicit", "numerics.elements=20000"))
+    msg = str(info.value)
+    assert msg.startswith("numerics.max_work: this explicit run may need ")
+    assert "node-steps" in msg and 'numerics.integrator = "implicit"' in msg
+    # the user can raise the limit (construction only: nothing runs)
+    Simulation(_scene("numerics.integrator=explicit", "numerics.elements=20000",
+                      "numerics.max_work=1e13"))
+    with pytest.raises(beltsim.SceneError, match="numerics.max_work: only for"):
+        Simulation(_scene("numerics.max_work=1e13"))

@@ -205,6 +205,7 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "snapshot_interval": POS,
         "newton_tol": POS,
         "newton_max_iterations": _Rule("int", minimum=1),
+        "max_work": POS,
     },
 }
 

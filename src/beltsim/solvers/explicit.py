@@ -73,6 +73,7 @@ from ..physics.model import hermite_weights, load_at
 from ..problem.drive import friction_factor, mismatch
 from .base import Scheme
 from .registry import register
+from .settings import EXPLICIT_RATE
 
 EXPLICIT_SAFETY = 0.9  # default explicit step as a fraction of the stability limit
 SMALL_STEP = 1e-5  # relative Newton step below which the friction solve stops
@@ -477,6 +478,13 @@ def explicit_stable_dt(params, h_min, damping):
                       float(P.c), float(P.h), float(h_min), float(damping))
 
 
+def _duration(seconds: float) -> str:
+    for unit, size in (("days", 86400.0), ("hours", 3600.0), ("minutes", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.3g} {unit}"
+    return f"{seconds:.3g} s"
+
+
 @register
 class ExplicitScheme(Scheme):
     """Trapezoidal velocity terms and an explicit kick (module notes), at EXPLICIT_SAFETY
@@ -499,6 +507,15 @@ class ExplicitScheme(Scheme):
                 f"{limit:.6g} s (von Neumann, on the smallest element, {grid.h_min:.3g} m: "
                 f"the waves of both fields with the shear, gyroscopic and friction terms)")
         dt = requested if requested is not None else EXPLICIT_SAFETY * limit
+        steps = math.ceil(num.t_end / dt)
+        work = steps * (grid.n_elements + 1.0)
+        if work > num.max_work:
+            raise SceneError(
+                f"numerics.max_work: this explicit run may need {work:.3g} node-steps "
+                f"({steps:.3g} steps of {dt:.3g} s to t_end = {num.t_end:.4g} s, "
+                f"{grid.n_elements + 1} nodes; about {_duration(work / EXPLICIT_RATE)} at "
+                f"{EXPLICIT_RATE:.0e} node-steps/s), above max_work = {num.max_work:.3g}; "
+                f'use numerics.integrator = "implicit", or raise numerics.max_work')
         self.numerics = dataclasses.replace(num, dt=dt)
         self.hist = History.zeros(grid.n_elements + 1)
         self.hist_at = (math.nan, math.nan)  # the (t, dt) the history belongs to

@@ -27,7 +27,14 @@ Defaults (all overridable in [numerics]):
 * ``steady_tol`` 1e-6: relative rates and relative change of the total friction
   per window (one transit time L / c) that count as steady;
 * ``newton_tol`` 1e-9 (scaled max norm of the Newton update) and
-  ``newton_max_iterations`` 30 per implicit step.
+  ``newton_max_iterations`` 30 per implicit step;
+* ``max_work`` (the explicit scheme only) 2e10 node-steps: the most a run may need,
+  (t_end / dt) steps of every node, before it is refused (about 10 minutes at the
+  kernel's 3e7 node-steps per second).
+
+Every grid is first checked against the machine's available memory (MEMORY_PER_NODE
+bytes a node, measured at 2e6 elements: 460 implicit, 390 pseudo, 270 explicit, with a
+margin): an oversized grid is refused before anything is allocated.
 """
 
 from __future__ import annotations
@@ -51,6 +58,9 @@ DEFAULT_GRADING = 8.0
 ELEMENTS_PER_LAYER = 16.0
 DEFAULT_TIME_TOL = 1e-4
 MIN_MISMATCH = 1e-8  # smallest nonzero |v/c - 1| a run accepts
+DEFAULT_MAX_WORK = 2e10  # node-steps of an explicit run
+EXPLICIT_RATE = 3e7  # node-steps per second of the explicit kernel (bench), for messages
+MEMORY_PER_NODE = 600  # bytes a grid node costs a run at its peak
 MIN_VREG = 1e-12  # smallest regularisation velocity, relative to c
 
 
@@ -71,6 +81,7 @@ class Numerics:
     newton_tol: float = 1e-9
     newton_max_it: int = 30
     time_tol: float = DEFAULT_TIME_TOL
+    max_work: float = DEFAULT_MAX_WORK
     settle_time: float = 0.0  # when the drive stops changing (steady tests start there)
 
     @property
@@ -121,9 +132,14 @@ def resolve(scene: Scene) -> Numerics:
     if accelerated and P.inertia:
         omega1 = math.pi * P.B / (P.L * math.sqrt(P.rho * P.b1))
         acceleration = nm.get("acceleration", 2.0 * omega1)
+    if "max_work" in nm and integrator != "explicit":
+        raise SceneError('numerics.max_work: only for numerics.integrator = "explicit" (the '
+                         "other schemes' steps adapt)")
+    elements = nm.get("elements", default_elements(P))
+    check_memory(elements)
     return Numerics(
         integrator=integrator,
-        elements=nm.get("elements", default_elements(P)),
+        elements=elements,
         grading=nm.get("grading", DEFAULT_GRADING),
         dt=dt, t_end=t_end, ramp_time=ramp_time, law=law, vreg=vreg, fs=fs,
         acceleration=acceleration, steady_tol=nm.get("steady_tol", 1e-6),
@@ -132,7 +148,29 @@ def resolve(scene: Scene) -> Numerics:
         newton_max_it=nm.get("newton_max_iterations", 30),
         time_tol=nm.get("time_tol", DEFAULT_TIME_TOL),
         settle_time=settle_time(scene, ramp_time),
+        max_work=nm.get("max_work", DEFAULT_MAX_WORK),
     )
+
+
+def available_memory() -> float | None:
+    """Bytes the system can give a new allocation (MemAvailable), None where unknown."""
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024.0
+    except OSError:
+        pass
+    return None
+
+
+def check_memory(elements: int) -> None:
+    """Refuse a grid whose run would not fit in the available memory."""
+    need, have = MEMORY_PER_NODE * (elements + 1.0), available_memory()
+    if have is not None and need > have:
+        raise SceneError(f"numerics.elements: {elements} elements need about {need / 2**30:.3g} "
+                         f"GiB ({MEMORY_PER_NODE} bytes a node), more than the "
+                         f"{have / 2**30:.3g} GiB this machine has available")
 
 
 def settle_time(scene: Scene, ramp_time: float) -> float:
