@@ -37,9 +37,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..physics.model import POWER_TERMS, block_solve, power_terms
+from ..physics.model import LAM_MAX, POWER_TERMS, power_terms
 from ..problem.drive import friction_factor
-from .newton import FAILED, NONFINITE, OK, NewtonScheme, newton
+from .newton import FAILED, NONFINITE, OK, NewtonScheme, block_substitute, newton
 from .registry import register
 
 SAFETY = 0.8
@@ -58,6 +58,7 @@ class History(NamedTuple):
     td: np.ndarray
     au: np.ndarray  # u_tt, theta_tt at t_n
     at: np.ndarray
+    lam: np.ndarray  # the friction unknowns at t_{n-1} (the Newton predictor's)
 
     @classmethod
     def zeros(cls, n_nodes):
@@ -66,9 +67,11 @@ class History(NamedTuple):
 
 @njit(cache=True)
 def filtered_error(e, a0, fs, mesh, p, w, out):
-    """Solve J e_f = T e in place of ``e`` (n, 2); J: w's blocks, T: their a0 part.
+    """Solve J e_f = T e in place of ``e`` (n, 2); J: the step's Newton matrix, T: its a0 part.
 
-    fs: the friction scale at the step's time (f* times the profile's factor).
+    J is applied through the block LU the Newton solve left in ``w``, T takes the
+    friction slopes of that J (w.sgf); fs: the friction scale at the step's time (f*
+    times the profile's factor).
     """
     n = e.shape[0]
     rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
@@ -82,11 +85,27 @@ def filtered_error(e, a0, fs, mesh, p, w, out):
         out[i, 0] = kin * rho * hb[j] * e[i, 0] + rho * gyro * (e[i, 0] - ul)
         out[i, 1] = kin * I * hb[j] * e[i, 1] + I * gyro * (e[i, 1] - tl)
         if mesh.j1 < j <= mesh.j2:
-            k = he[j - 1] * fs * w.sg[j] / p.v_reg * a0
+            k = he[j - 1] * fs * w.sgf[j] / p.v_reg * a0
             eb = e[i, 0] + hh * e[i, 1]
             out[i, 0] += k * eb
             out[i, 1] += hh * k * eb
-    return block_solve(w.Lb, w.Db, w.Ub, out, e, w.C)
+    block_substitute(w, out, e)
+
+
+@njit(cache=True)
+def predict_friction(lam, lam_prev, r, mesh):
+    """Extrapolate the friction ratios lam (at t_n, in place) linearly to t_n + r (t_n - t_{n-1}).
+
+    A ratio moves at most half way to +-1: Newton leaves a ratio pressed against
+    the bound (slope 1 - lam^2 ~ 0) only slowly, and the extrapolation overshoots at
+    the onset of slip.
+    """
+    for j in range(mesh.j1 + 1, mesh.j2 + 1):
+        lp = lam[j] + r * (lam[j] - lam_prev[j])
+        if lp > lam[j]:
+            lam[j] = min(lp, lam[j] + 0.99 * (1.0 - lam[j]), LAM_MAX)
+        else:
+            lam[j] = max(lp, lam[j] - 0.99 * (1.0 + lam[j]), -LAM_MAX)
 
 
 @njit(cache=True)
@@ -146,6 +165,8 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
         for j in range(1, N):
             u[j] = u_n[j] + h * ud_n[j] + 0.5 * h * h * hist.au[j]
             th[j] = th_n[j] + h * td_n[j] + 0.5 * h * h * hist.at[j]
+        if h_prev > 0.0:
+            predict_friction(lam, hist.lam, h / h_prev, mesh)
         ok = newton(state, base, a0, t + h, mesh, p, drive, loads, scales, settings, w)
         err = 0.0
         finite = True
@@ -160,11 +181,11 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
             for i in range(N - 1):
                 e[i, 0] = err_const * h * h * (au_new[i + 1] - hist.au[i + 1])
                 e[i, 1] = err_const * h * h * (at_new[i + 1] - hist.at[i + 1])
-            if filtered_error(e, a0, p.friction_scale * friction_factor(drive, t + h), mesh, p, w,
-                              te):
-                for i in range(N - 1):
-                    err = max(err, abs(e[i, 0]) / scales.u, abs(e[i, 1]) / scales.theta)
-            else:
+            filtered_error(e, a0, p.friction_scale * friction_factor(drive, t + h), mesh, p, w,
+                           te)
+            for i in range(N - 1):
+                err = max(err, abs(e[i, 0]) / scales.u, abs(e[i, 1]) / scales.theta)
+            if not math.isfinite(err):
                 err = np.inf
         if ok and not finite:
             for j in range(N + 1):
@@ -175,6 +196,7 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
                 hist.u[j], hist.theta[j] = u_n[j], th_n[j]
                 hist.ud[j], hist.td[j] = ud_n[j], td_n[j]
                 hist.au[j], hist.at[j] = au_new[j], at_new[j]
+                hist.lam[j] = lam_n[j]
             t = t_stop if parts == 1 else t + h  # the last part lands on t_stop exactly
             steps += 1
             h_prev = h
@@ -242,4 +264,6 @@ class ImplicitScheme(NewtonScheme):
         self.h_prev, self.h_next = (float(v) for v in data["h"])
         self.power[:], self.work_done[:] = data["power"], data["work_done"]
         for k, a in zip(History._fields, self.hist):
-            a[:] = data[f"hist_{k}"]
+            # a checkpoint of an earlier version has no friction ratios at t_{n-1}: zeros
+            # cost the next Newton solve a worse start (the predictor caps the jump)
+            a[:] = data[f"hist_{k}"] if k != "lam" or "hist_lam" in data else 0.0

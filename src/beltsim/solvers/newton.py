@@ -10,13 +10,16 @@ unknown, kept inside (-1, 1)) converges with full steps.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from ..errors import NumericalError
-from ..physics.model import assemble, block_solve, update_multipliers
+from ..physics.friction import law, law_inverse
+from ..physics.model import assemble, update_multipliers
+from ..problem.drive import friction_factor
 from .base import Scheme
 
 # status codes of the time-stepping kernels that solve with Newton
@@ -25,6 +28,13 @@ OK, FAILED, NONFINITE = 0, 1, 2
 # converged: 1e3 * 1e-9 = 1e-6, an order below the discretisation error of the finest
 # grid tried (1.4e-5 on 20,000 elements).
 ROUNDOFF_FLOOR = 1e3
+# Largest ratio of successive updates from which the error left after an update is
+# estimated (rate / (1 - rate) times the update) to stop before it falls below tol
+CONTRACTION = 0.5
+# A friction ratio with slope dlam/ds below NEAR_BOUND (|lam| > 0.995 for tanh) that
+# differs from the law at its slip velocity by more than LAW_GAP is stuck at the bound
+NEAR_BOUND = 1e-2
+LAW_GAP = 1e-3
 
 #: Counters a scheme accumulates, one record the kernels update in place.
 STATS_DTYPE = np.dtype([("newton_iterations", np.int64), ("failed_steps", np.int64),
@@ -43,21 +53,27 @@ class Workspace(NamedTuple):
     Lb: np.ndarray  # Jacobian blocks (n, 2, 2)
     Db: np.ndarray
     Ub: np.ndarray
-    C: np.ndarray  # block Thomas pivots
+    C: np.ndarray  # block LU of the Jacobian (block_factor): inverse pivots (n, 2, 2),
+    W: np.ndarray  # multipliers,
+    U: np.ndarray  # upper blocks (a line search assembles Ub anew)
     dx: np.ndarray  # Newton update (n, 2)
     u_try: np.ndarray  # line-search trial (N + 1)
     th_try: np.ndarray
     rl: np.ndarray  # friction equation residuals (N + 1)
     sg: np.ndarray  # friction slopes (N + 1)
+    sgf: np.ndarray  # those of the factorised Jacobian
+    lam0: np.ndarray  # friction ratios before the last update (N + 1)
     stats: np.ndarray  # one record of STATS_DTYPE
 
     @classmethod
     def allocate(cls, n_elements: int) -> "Workspace":
         N, n = n_elements, n_elements - 1
         return cls(R=np.zeros((n, 2)), Lb=np.zeros((n, 2, 2)), Db=np.zeros((n, 2, 2)),
-                   Ub=np.zeros((n, 2, 2)), C=np.zeros((n, 2, 2)), dx=np.zeros((n, 2)),
+                   Ub=np.zeros((n, 2, 2)), C=np.zeros((n, 2, 2)), W=np.zeros((n, 2, 2)),
+                   U=np.zeros((n, 2, 2)), dx=np.zeros((n, 2)),
                    u_try=np.zeros(N + 1), th_try=np.zeros(N + 1), rl=np.zeros(N + 1),
-                   sg=np.zeros(N + 1), stats=np.zeros(1, STATS_DTYPE))
+                   sg=np.zeros(N + 1), sgf=np.zeros(N + 1), lam0=np.zeros(N + 1),
+                   stats=np.zeros(1, STATS_DTYPE))
 
 
 @njit(cache=True)
@@ -71,14 +87,114 @@ def merit(R, scales):
 
 
 @njit(cache=True)
+def block_factor(Lb, Db, Ub, w):
+    """Block LU of a block-tridiagonal matrix (2x2 blocks) for :func:`block_substitute`.
+
+    With the pivots S_0 = D_0, S_i = D_i - W_i U_{i-1}, W_i = L_i S_{i-1}^{-1}: w.C
+    receives the inverses S_i^{-1}, w.W the W_i, w.U a copy of the U_i. The factors
+    serve several right-hand sides: a simplified Newton iteration's and the step's
+    error estimate. Returns False on a singular pivot.
+    """
+    C, W, U = w.C, w.W, w.U
+    n = Db.shape[0]
+    q00 = q01 = q10 = q11 = 0.0  # S_{i-1}^{-1}
+    regular = True  # (a flag, not a branch out of the loop: that costs a third of the time)
+    for i in range(n):
+        s00, s01, s10, s11 = Db[i, 0, 0], Db[i, 0, 1], Db[i, 1, 0], Db[i, 1, 1]
+        if i > 0:
+            l00, l01, l10, l11 = Lb[i, 0, 0], Lb[i, 0, 1], Lb[i, 1, 0], Lb[i, 1, 1]
+            w00 = l00 * q00 + l01 * q10
+            w01 = l00 * q01 + l01 * q11
+            w10 = l10 * q00 + l11 * q10
+            w11 = l10 * q01 + l11 * q11
+            u00, u01, u10, u11 = Ub[i - 1, 0, 0], Ub[i - 1, 0, 1], Ub[i - 1, 1, 0], Ub[i - 1, 1, 1]
+            U[i - 1, 0, 0], U[i - 1, 0, 1], U[i - 1, 1, 0], U[i - 1, 1, 1] = u00, u01, u10, u11
+            s00 -= w00 * u00 + w01 * u10
+            s01 -= w00 * u01 + w01 * u11
+            s10 -= w10 * u00 + w11 * u10
+            s11 -= w10 * u01 + w11 * u11
+            W[i, 0, 0], W[i, 0, 1], W[i, 1, 0], W[i, 1, 1] = w00, w01, w10, w11
+        det = s00 * s11 - s01 * s10
+        regular = regular & (abs(det) > 0.0) & (abs(det) < math.inf)
+        g = 1.0 / det
+        q00, q01, q10, q11 = s11 * g, -s01 * g, -s10 * g, s00 * g
+        C[i, 0, 0], C[i, 0, 1], C[i, 1, 0], C[i, 1, 1] = q00, q01, q10, q11
+    return regular
+
+
+@njit(cache=True)
+def block_substitute(w, r, x):
+    """Solve with the factors of :func:`block_factor`: x (n, 2) from r (n, 2); r is kept."""
+    C, W, Ub = w.C, w.W, w.U
+    n = r.shape[0]
+    y0 = y1 = 0.0
+    for i in range(n):  # forward: y_i = r_i - W_i y_{i-1}, kept in x
+        if i > 0:
+            y0, y1 = (r[i, 0] - W[i, 0, 0] * y0 - W[i, 0, 1] * y1,
+                      r[i, 1] - W[i, 1, 0] * y0 - W[i, 1, 1] * y1)
+        else:
+            y0, y1 = r[0, 0], r[0, 1]
+        x[i, 0], x[i, 1] = y0, y1
+    x0 = x1 = 0.0
+    for i in range(n - 1, -1, -1):  # backward: x_i = S_i^{-1} (y_i - U_i x_{i+1})
+        z0, z1 = x[i, 0], x[i, 1]
+        if i < n - 1:
+            z0 -= Ub[i, 0, 0] * x0 + Ub[i, 0, 1] * x1
+            z1 -= Ub[i, 1, 0] * x0 + Ub[i, 1, 1] * x1
+        x0 = C[i, 0, 0] * z0 + C[i, 0, 1] * z1
+        x1 = C[i, 1, 0] * z0 + C[i, 1, 1] * z1
+        x[i, 0], x[i, 1] = x0, x1
+
+
+@njit(cache=True)
+def factorise(w, mesh):
+    """Factorise w's Jacobian blocks; keep the friction slopes they hold (w.sgf)."""
+    for j in range(mesh.j1 + 1, mesh.j2 + 1):
+        w.sgf[j] = w.sg[j]
+    return block_factor(w.Lb, w.Db, w.Ub, w)
+
+
+@njit(cache=True)
+def friction_forces(lam, fnode, t, mesh, p, drive):
+    """The nodal friction forces of the friction ratios lam, as :func:`assemble` sets them."""
+    fs = p.friction_scale * friction_factor(drive, t)
+    for j in range(mesh.j1 + 1, mesh.j2 + 1):
+        fnode[j] = -mesh.he[j - 1] * fs * lam[j]
+
+
+@njit(cache=True)
+def stuck_at_bound(lam, w, mesh, code):
+    """Whether a friction ratio pressed against +-1 contradicts the slip velocity.
+
+    Near the bound the dual update sg (rl + ...) is tiny (slope sg = 1 - lam^2 for tanh)
+    even when the slip velocity has turned: a node leaving the slip at a stick
+    transition stays at lam = -1 with v_rel / v_reg = +50, and the updates pass every
+    test above. Such a ratio (sg below NEAR_BOUND, off g(v_rel / v_reg) of the iterate
+    before the update by more than LAW_GAP) is not converged; Newton goes on, and the
+    update, which grows by about 1 + 2 |rl| per iteration, takes it off the bound.
+    """
+    for j in range(mesh.j1 + 1, mesh.j2 + 1):
+        if w.sg[j] < NEAR_BOUND and lam[j] * w.rl[j] < 0.0:
+            s = w.rl[j] + law_inverse(code, w.lam0[j])[0]
+            if abs(law(code, s)[0] - lam[j]) > LAW_GAP:
+                return True
+    return False
+
+
+@njit(cache=True)
 def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     """Solve the step's residual for (u, theta, lam) of ``state`` in place, from their values.
 
     Converged when the update is below settings.tol (scaled max norm; absolute for
-    lam), or when it has reached the round-off floor: below ROUNDOFF_FLOOR * tol and no
-    longer halving. The floor grows with the condition number of the Jacobian,
-    ~ (L / h_min)^2: on 20,000 elements the update stalls near 1e-8 and a fixed 1e-9
-    failed every step. Returns True on convergence.
+    lam), when the error it leaves is: rate / (1 - rate) times the update, the rate
+    being the ratio of successive updates (below CONTRACTION), or when it has reached
+    the round-off floor: below ROUNDOFF_FLOOR * tol and no longer halving. The floor
+    grows with the condition number of the Jacobian, ~ (L / h_min)^2: on 20,000
+    elements the update stalls near 1e-8 and a fixed 1e-9 failed every step.
+
+    On return, w holds the block LU of the Jacobian last factorised (block_factor)
+    and the friction slopes it was assembled with (w.sgf), for the step's error
+    estimate. Returns True on convergence.
     """
     u, th, lam, fnode = state.u, state.theta, state.lam, state.fnode
     R, dx, u_try, th_try = w.R, w.dx, w.u_try, w.th_try
@@ -88,32 +204,40 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
     m0 = merit(R, scales)
     if m0 == 0.0:
-        return True
+        return factorise(w, mesh)  # the factors are the step's (its error estimate's)
     previous = np.inf
     for it in range(settings.max_iterations):
         st.newton_iterations += 1
         for i in range(n):
             R[i, 0] = -R[i, 0]
             R[i, 1] = -R[i, 1]
-        if not block_solve(w.Lb, w.Db, w.Ub, R, dx, w.C):
+        if not factorise(w, mesh):
+            st.merit = merit(R, scales)
             return False
+        block_substitute(w, R, dx)
         step = 0.0
         for i in range(n):
             s = max(abs(dx[i, 0]) / scales.u, abs(dx[i, 1]) / scales.theta)
             if s > step:
                 step = s
         if not np.isfinite(step):
+            st.merit = merit(R, scales)
             return False
         if p.dual:
+            for j in range(mesh.j1 + 1, mesh.j2 + 1):
+                w.lam0[j] = lam[j]
             dlam = update_multipliers(lam, dx, inv_dt, mesh, p, w)
             for i in range(n):
                 u[i + 1] += dx[i, 0]
                 th[i + 1] += dx[i, 1]
-            assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
-            st.merit = merit(R, scales)
             update = max(step, dlam)
-            if update < tol or (update < ROUNDOFF_FLOOR * tol and update > 0.5 * previous):
+            rate = update / previous if it > 0 else 1.0
+            if ((update < tol or (update < ROUNDOFF_FLOOR * tol and update > 0.5 * previous)
+                    or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol))
+                    and not stuck_at_bound(lam, w, mesh, p.law)):
+                friction_forces(lam, fnode, t, mesh, p, drive)
                 return True
+            assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
             previous = update
             continue
         alpha = 1.0
@@ -142,6 +266,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
         st.merit = m
         if alpha * step < tol or m < 1e-30:
             return True
+    st.merit = merit(R, scales)
     return False
 
 
