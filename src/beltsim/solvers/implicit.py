@@ -96,16 +96,13 @@ def filtered_error(e, a0, fs, mesh, p, w, out):
 def predict_friction(lam, lam_prev, r, mesh):
     """Extrapolate the friction ratios lam (at t_n, in place) linearly to t_n + r (t_n - t_{n-1}).
 
-    A ratio moves at most half way to +-1: Newton leaves a ratio pressed against
-    the bound (slope 1 - lam^2 ~ 0) only slowly, and the extrapolation overshoots at
-    the onset of slip.
+    Kept inside the bounds of the primal-dual iteration (+-LAM_MAX): a node that
+    reaches slip in the step starts there, and one that the extrapolation takes to
+    the bound wrongly is caught by Newton's check of the ratios at the bound
+    (:func:`beltsim.solvers.newton.release_stuck_ratios`).
     """
     for j in range(mesh.j1 + 1, mesh.j2 + 1):
-        lp = lam[j] + r * (lam[j] - lam_prev[j])
-        if lp > lam[j]:
-            lam[j] = min(lp, lam[j] + 0.99 * (1.0 - lam[j]), LAM_MAX)
-        else:
-            lam[j] = max(lp, lam[j] - 0.99 * (1.0 + lam[j]), -LAM_MAX)
+        lam[j] = min(LAM_MAX, max(-LAM_MAX, lam[j] + r * (lam[j] - lam_prev[j])))
 
 
 @njit(cache=True)
@@ -265,5 +262,5 @@ class ImplicitScheme(NewtonScheme):
         self.power[:], self.work_done[:] = data["power"], data["work_done"]
         for k, a in zip(History._fields, self.hist):
             # a checkpoint of an earlier version has no friction ratios at t_{n-1}: zeros
-            # cost the next Newton solve a worse start (the predictor caps the jump)
+            # give the next step's Newton solve a worse start, nothing else
             a[:] = data[f"hist_{k}"] if k != "lam" or "hist_lam" in data else 0.0

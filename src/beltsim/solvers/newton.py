@@ -28,8 +28,9 @@ OK, FAILED, NONFINITE = 0, 1, 2
 # converged: 1e3 * 1e-9 = 1e-6, an order below the discretisation error of the finest
 # grid tried (1.4e-5 on 20,000 elements).
 ROUNDOFF_FLOOR = 1e3
-# Largest ratio of successive updates from which the error left after an update is
-# estimated (rate / (1 - rate) times the update) to stop before it falls below tol
+# Largest ratio of successive updates (the rate) with which the error an update leaves
+# is estimated as rate / (1 - rate) times the update: Newton stops when that is below
+# tol, one iteration before the update itself would be
 CONTRACTION = 0.5
 # A friction ratio with slope dlam/ds below NEAR_BOUND (|lam| > 0.995 for tanh) that
 # differs from the law at its slip velocity by more than LAW_GAP is stuck at the bound
@@ -86,14 +87,14 @@ def merit(R, scales):
     return m
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")  # a zero pivot gives inf, and False, not an exception
 def block_factor(Lb, Db, Ub, w):
     """Block LU of a block-tridiagonal matrix (2x2 blocks) for :func:`block_substitute`.
 
     With the pivots S_0 = D_0, S_i = D_i - W_i U_{i-1}, W_i = L_i S_{i-1}^{-1}: w.C
     receives the inverses S_i^{-1}, w.W the W_i, w.U a copy of the U_i. The factors
-    serve several right-hand sides: a simplified Newton iteration's and the step's
-    error estimate. Returns False on a singular pivot.
+    serve two right-hand sides: the Newton update and the step's error estimate
+    (implicit.filtered_error). Returns False on a singular pivot.
     """
     C, W, U = w.C, w.W, w.U
     n = Db.shape[0]
@@ -163,22 +164,25 @@ def friction_forces(lam, fnode, t, mesh, p, drive):
 
 
 @njit(cache=True)
-def stuck_at_bound(lam, w, mesh, code):
-    """Whether a friction ratio pressed against +-1 contradicts the slip velocity.
+def release_stuck_ratios(lam, w, mesh, code):
+    """Restart the friction ratios stuck at +-1 against their slip velocity; any?
 
     Near the bound the dual update sg (rl + ...) is tiny (slope sg = 1 - lam^2 for tanh)
     even when the slip velocity has turned: a node leaving the slip at a stick
     transition stays at lam = -1 with v_rel / v_reg = +50, and the updates pass every
-    test above. Such a ratio (sg below NEAR_BOUND, off g(v_rel / v_reg) of the iterate
-    before the update by more than LAW_GAP) is not converged; Newton goes on, and the
-    update, which grows by about 1 + 2 |rl| per iteration, takes it off the bound.
+    convergence test. Such a ratio (sg below NEAR_BOUND, off g(v_rel / v_reg) of the
+    iterate before the update by more than LAW_GAP) is not converged: it restarts from
+    0, where the slope is largest (from the bound the update grows only by a factor
+    1 + 2 |rl| per iteration), and Newton goes on.
     """
+    stuck = False
     for j in range(mesh.j1 + 1, mesh.j2 + 1):
         if w.sg[j] < NEAR_BOUND and lam[j] * w.rl[j] < 0.0:
             s = w.rl[j] + law_inverse(code, w.lam0[j])[0]
             if abs(law(code, s)[0] - lam[j]) > LAW_GAP:
-                return True
-    return False
+                lam[j] = 0.0
+                stuck = True
+    return stuck
 
 
 @njit(cache=True)
@@ -190,7 +194,8 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     being the ratio of successive updates (below CONTRACTION), or when it has reached
     the round-off floor: below ROUNDOFF_FLOOR * tol and no longer halving. The floor
     grows with the condition number of the Jacobian, ~ (L / h_min)^2: on 20,000
-    elements the update stalls near 1e-8 and a fixed 1e-9 failed every step.
+    elements the update stalls near 1e-8 and a fixed 1e-9 failed every step. None of
+    these counts while a friction ratio is stuck at +-1 (:func:`release_stuck_ratios`).
 
     On return, w holds the block LU of the Jacobian last factorised (block_factor)
     and the friction slopes it was assembled with (w.sgf), for the step's error
@@ -231,10 +236,10 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
                 u[i + 1] += dx[i, 0]
                 th[i + 1] += dx[i, 1]
             update = max(step, dlam)
-            rate = update / previous if it > 0 else 1.0
+            rate = update / previous if it > 0 and previous > 0.0 else 1.0
             if ((update < tol or (update < ROUNDOFF_FLOOR * tol and update > 0.5 * previous)
                     or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol))
-                    and not stuck_at_bound(lam, w, mesh, p.law)):
+                    and not release_stuck_ratios(lam, w, mesh, p.law)):
                 friction_forces(lam, fnode, t, mesh, p, drive)
                 return True
             assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
