@@ -4,9 +4,10 @@ import json
 
 import numpy as np
 
+from beltsim.physics.friction import LINEAR
 from beltsim.problem.scene import load_scene
 from beltsim.simulation.controller import Simulation
-from beltsim.studies import bench, convergence
+from beltsim.studies import bench, convergence, peers
 from helpers import cli, scene_path
 
 
@@ -71,21 +72,74 @@ def test_peer_rhs_is_the_semi_discrete_model():
 
 
 def test_bench_command_prints_json_last(tmp_path):
-    # a coarse grid and a soft regularisation keep the peer to seconds
-    # (and a strong physical damping: the peer has no adaptive damping of its own)
-    proc = cli("bench", scene_path("paper_slip"), "--set", "numerics.elements=40",
-               "--set", "numerics.regularisation=0.05", "--set", "physics.damping=650",
-               "--no-cold")
+    proc = cli("bench", scene_path("paper_slip"), "--elements", "20", "--repeat", "1",
+               "--peer-cap", "60", "--no-cold")
     assert proc.returncode == 0, proc.stderr
     last = json.loads(proc.stdout.strip().splitlines()[-1])
     for key in ("ours_wall_time", "ours_error", "peer_wall_time", "peer_error", "speedup",
-                "explicit_node_steps_per_s", "cold_start_time"):
+                "explicit_node_steps_per_s", "cold_start_time", "peers", "steady_speedup",
+                "kernel_speedup"):
         assert key in last
+    assert last["elements"] == 20
     assert last["ours_wall_time"] > 0 and last["peer_wall_time"] > 0
-    assert last["peer_converged"] is True
+    assert last["peer_converged"] is True and last["peer"] in ("radau", "bdf")
+    assert last["speedup"] == last["peer_wall_time"] / last["ours_wall_time"]
+    for name in ("radau", "bdf", "newton"):
+        row = last["peers"][name]
+        assert {"wall_time", "error", "converged", "tolerance"} <= row.keys()
+    assert last["peers"]["newton"]["converged"] is True and last["steady_speedup"] > 0
     # same grid, same discretisation, same steady criterion: the same steady state
     assert abs(last["ours_error"] - last["peer_error"]) < 1e-4
     assert last["explicit_node_steps_per_s"] > 0
+
+
+def test_bench_refuses_a_bad_repeat_count(capsys):
+    from beltsim.cli import main
+    assert main(["bench", str(scene_path("paper_slip")), "--repeat", "0", "--no-cold"]) == 2
+    assert "--repeat" in capsys.readouterr().err
+
+
+def test_peer_jacobian_is_the_derivative_of_its_rhs():
+    """The analytic sparse Jacobian against 4th-order central differences of the rhs, at a
+    random state whose contact nodes sit on the steep part of the friction law."""
+    sim = Simulation(load_scene(scene_path("paper_slip"), ["numerics.elements=30",
+                                                           "numerics.regularisation=0.05"]))
+    sysm = peers.PeerSystem(sim)
+    n, t = sysm.n, 0.002  # early in the speed ramp: the mismatch is still near v_reg
+    scale = peers._state_scale(sim, n)
+    y = 1e-3 * scale * np.random.default_rng(0).standard_normal(4 * n)
+    J = sysm.jacobian(t, y).toarray()
+    fd = np.empty_like(J)
+    for k in range(4 * n):
+        e = np.zeros(4 * n)
+        e[k] = 1e-4 * 1e-3 * scale[k]
+        f = [sysm.rhs(t, y + m * e) for m in (-2, -1, 1, 2)]
+        fd[:, k] = (f[0] - 8 * f[1] + 8 * f[2] - f[3]) / (12 * e[k])
+    # in the unknowns' own units, each row relative to its largest entry
+    err = (np.abs(J - fd) * scale).max(axis=1) / (np.abs(J) * scale).max(axis=1)
+    assert err.max() < 1e-6
+    # the friction part was exercised: several contact nodes are far from saturation
+    linear = sim.disc.model._replace(law=LINEAR)  # slope 1 everywhere
+    slopes = sysm.friction_entries(t, y) / sysm.friction_entries(t, y, p=linear)
+    assert (slopes > 0.3).sum() >= 6 * 12  # at least 6 of the 12 contact nodes, 12 entries each
+
+
+def test_steady_peer_lands_on_the_steady_scheme_state():
+    scene = load_scene(scene_path("paper_slip"), ["numerics.elements=100",
+                                                  "numerics.integrator=steady"])
+    ours = Simulation(scene).run().solution.total_friction
+    res = peers.run_steady_peer(Simulation(scene))
+    assert res.converged, res.reason
+    assert abs(res.total_friction - ours) < 1e-8 * abs(ours)
+
+
+def test_radau_peer_reaches_the_steady_state_on_a_tiny_grid():
+    scene = load_scene(scene_path("paper_slip"), ["numerics.elements=20"])
+    res = peers.run_transient_peer(Simulation(scene), "Radau", max_wall=60.0)
+    assert res.converged, res.reason
+    steady = Simulation(scene.with_overrides(["numerics.integrator=steady"])).run()
+    ref = steady.solution.total_friction
+    assert abs(res.total_friction - ref) < peers.SAME_STATE * abs(ref)
 
 
 def test_bisected_grid_is_nested():

@@ -1,0 +1,319 @@
+"""Random scenes across the whole parameter space, each by every applicable scheme.
+
+`beltsim stability --random N --seed S` draws N valid scenes and runs each with every
+registered scheme at its default grid. A cell is judged exactly as in the stability
+matrix (:func:`beltsim.studies.stability.stability_cell`, its statuses, ACCEPTED and
+BOUNDS): each drawn scene becomes a :class:`~beltsim.studies.stability.Case` whose
+overrides set every key of a shipped scene, so nothing of the matrix's logic is copied.
+Only the slip start's bound, in metres, is scaled to the scene's grid (:func:`scene_bounds`).
+
+Scene i of seed S is drawn from its own generator ``default_rng([S, i])``: the same seed
+draws the same scenes whatever N, and a failure is reproduced from (S, i) alone.
+
+What is drawn (log-uniform unless said otherwise):
+
+* geometry: length 0.1 .. 50 m, slenderness L / h 3 .. 300, width / h 0.2 .. 10, and
+  the inlet, contact and outlet spans as weights 0.02 .. 1 (so each is at least 1% of L);
+* materials: E 1e5 .. 1e11 Pa, density 300 .. 8000 kg/m^3, poisson_ratio uniform over
+  (-1, 0.5), shear_factor 0.4 .. 1.5;
+* speed: c = r c_low with c_low the lower critical speed of the beam (with inertia; a
+  quasistatic scene has none, and its c only scales time) and r 1e-3 .. 0.95 for half
+  the scenes, uniform 0.5 .. 0.95 for the other half (the near-critical band, where the
+  effective bending stiffness a - I c^2 is small);
+* mismatch: v = c (1 + s e), s = +-1, e 1e-6 .. 0.05;
+* friction: stick or coulomb (half each); f* = R B |e0| / (x2 - x1), R 0.1 .. 1e4: the
+  contact can carry about B |e0| in stick, so R below about 1 makes it slide whole;
+* inertia on for half the scenes; physics.damping 0 for half of the inertial ones, else
+  2 zeta omega with zeta 0.5% .. 5% of critical in the axial mode of a free span
+  omega = 3 pi B / (L sqrt(rho b1)) (as the shipped scenes state it).
+
+The default grid follows the scene (settings.default_elements), so slender belts and
+poisson_ratio near -1 (a stiff shear, a thin boundary layer) get fine grids: the explicit
+scheme is then refused above numerics.max_work, which is an accepted outcome.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import time
+from collections import Counter
+
+import numpy as np
+
+from .. import solvers
+from ..problem.scene import Scene
+from .convergence import ERROR_KEYS
+from .stability import ACCEPTED, BOUNDS, Case, CellStatus, stability_cell
+
+SKIPPED = "skipped"  # not started: the run's --max-wall was spent
+CRASHED = "crashed"  # an exception that is not one of beltsim's own errors (a bug)
+#: Every key a drawn scene sets; the shipped base is fully overridden by them.
+SCENE_KEYS = {
+    "beam": ("length", "height", "width", "youngs_modulus", "poisson_ratio", "density",
+             "shear_factor"),
+    "motion": ("belt_speed", "surface_speed"),
+    "contact": ("start", "end", "friction", "max_friction"),
+    "physics": ("inertia", "damping"),
+}
+PAPER_ELEMENTS = 1000  # the grid of the paper scenes (L = 1 m) that BOUNDS were set on
+_BASE = {"stick": "paper_inertia", "coulomb": "paper_slip"}  # runs/ scenes with these keys
+#: Columns of random.csv.
+COLUMNS = ("index", "scheme", "status", "reason_key", "friction", "inertia", "damping",
+           "mismatch", "speed_ratio", "elements", "dt", "steps", "wall_time",
+           "elapsed") + tuple(f"error_{k}" for k in ERROR_KEYS) + ("reason",)
+TEXT_COLUMNS = {"index", "scheme", "status", "reason_key", "friction", "inertia", "elements",
+                "steps", "reason"}
+INTERRUPTED = "interrupted (SIGINT)"  # the reason of cells skipped after a Ctrl-C
+
+
+def _log_uniform(rng, lo, hi):
+    return float(math.exp(rng.uniform(math.log(lo), math.log(hi))))
+
+
+def _sig(x, digits=4):
+    """A readable scene file: inputs rounded to a few digits (they are drawn, not measured)."""
+    return float(f"{x:.{digits - 1}e}")
+
+
+def draw_scene(seed: int, index: int) -> Scene:
+    """Scene `index` of `seed`: valid by construction (Scene validates it)."""
+    rng = np.random.default_rng([seed, index])
+    L = _sig(_log_uniform(rng, 0.1, 50.0))
+    h = _sig(L / _log_uniform(rng, 3.0, 300.0))
+    w = _sig(h * _log_uniform(rng, 0.2, 10.0))
+    spans = np.array([_log_uniform(rng, 0.02, 1.0) for _ in range(3)])
+    x1, x2 = L * np.cumsum(spans / spans.sum())[:2]
+    x1, x2 = _sig(x1, 6), _sig(x2, 6)
+    E = _sig(_log_uniform(rng, 1e5, 1e11))
+    nu = 0.0
+    while True:  # the open interval (-1, 0.5): uniform() may return its lower end
+        nu = _sig(rng.uniform(-1.0, 0.5))
+        if -1.0 < nu < 0.5:
+            break
+    density = _sig(_log_uniform(rng, 300.0, 8000.0))
+    k = _sig(_log_uniform(rng, 0.4, 1.5))
+    inertia = bool(rng.random() < 0.5)
+    b1, a = E * w * h, E * w * h**3 / 12.0
+    rho, rot = density * h * w, density * h * w * (h * h + w * w) / 12.0
+    c_low = min(math.sqrt(b1 / rho), math.sqrt(a / rot))
+    r = (_log_uniform(rng, 1e-3, 0.95) if rng.random() < 0.5 else rng.uniform(0.5, 0.95))
+    c = _sig(r * c_low, 6)
+    e = _log_uniform(rng, 1e-6, 0.05) * (1.0 if rng.random() < 0.5 else -1.0)
+    v = c * (1.0 + e)  # full precision: |e| reaches 1e-6
+    B = b1 - (rho * c * c if inertia else 0.0)
+    friction = "stick" if rng.random() < 0.5 else "coulomb"
+    ratio = _log_uniform(rng, 0.1, 1e4)
+    damped = inertia and rng.random() < 0.5
+    zeta = _log_uniform(rng, 0.005, 0.05)
+    omega = 3.0 * math.pi * B / (L * math.sqrt(rho * b1))
+    data = {
+        "title": f"random scene {index} (seed {seed})",
+        "beam": {"length": L, "height": h, "width": w, "youngs_modulus": E,
+                 "poisson_ratio": nu, "density": density, "shear_factor": k},
+        "motion": {"belt_speed": c, "surface_speed": v},
+        "contact": {"start": x1, "end": x2, "friction": friction},
+        "physics": {"inertia": inertia,
+                    "damping": _sig(2.0 * zeta * omega) if damped else 0.0},
+    }
+    if friction == "coulomb":
+        data["contact"]["max_friction"] = _sig(ratio * B * abs(v / c - 1.0) / (x2 - x1))
+    return Scene.from_dict(data)
+
+
+def draw_scenes(n: int, seed: int) -> list[Scene]:
+    return [draw_scene(seed, i) for i in range(n)]
+
+
+def scene_case(scene: Scene) -> Case:
+    """The scene as a stability case: a shipped scene with every key overridden."""
+    data = scene.to_dict()
+    sets = [f"title={_toml(data['title'])}"] + [
+        f"{section}.{key}={_toml(data[section][key])}"
+        for section, keys in SCENE_KEYS.items() for key in keys if key in data[section]]
+    return Case(data["title"], _BASE[scene.params.friction], tuple(sets))
+
+
+def _toml(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return repr(float(value))  # repr round-trips and is a TOML float
+
+
+_KEY = re.compile(r"^([a-z_]+\.[a-z_/]+):")
+
+
+def reason_key(status, reason: str) -> str:
+    """What a reason is about: the key a refusal names, the errors out of bounds, or the
+    kind of failure (numbers dropped, so that alike failures count together)."""
+    status = getattr(status, "value", status)
+    m = _KEY.match(reason or "")
+    if m:
+        return m.group(1)
+    if status == CellStatus.OUT_OF_BOUNDS.value:
+        return ", ".join(part.split()[0] for part in reason.split("; "))
+    if status in (CellStatus.NOT_CONVERGED.value, CellStatus.DIVERGED.value, CRASHED):
+        words = re.sub(r"[-+]?\d[\d.e+-]*", "#", reason or "").split("(")[0]
+        return words.strip()[:70]
+    return ""
+
+
+def failed(row) -> bool:
+    return row["status"] not in ACCEPTED and row["status"] != SKIPPED
+
+
+def random_cell(scene: Scene, index: int, scheme: str, extra=()) -> dict:
+    """One scene by one scheme, judged by the stability matrix's rules."""
+    start = time.perf_counter()
+    try:
+        cell = stability_cell(scene_case(scene), scheme, extra=extra)
+    except Exception as exc:  # noqa: BLE001  a crash is a finding, the rest must still run
+        cell = {"scheme": scheme, "status": CRASHED,
+                "reason": f"{type(exc).__name__}: {exc}".replace("\n", " "),
+                "dt": math.nan, "steps": 0, "wall_time": math.nan,
+                **{f"error_{k}": math.nan for k in ERROR_KEYS}}
+    status = getattr(cell["status"], "value", cell["status"])
+    reason = cell["reason"] or ""
+    info = describe(scene, extra)
+    if status in (CellStatus.CONVERGED.value, CellStatus.OUT_OF_BOUNDS.value):
+        bounds = scene_bounds(scene, info["elements"])
+        over = [f"{k} {cell[f'error_{k}']:.3g} > {b:g}" for k, b in bounds.items()
+                if math.isfinite(cell[f"error_{k}"]) and not cell[f"error_{k}"] <= b]
+        status = (CellStatus.OUT_OF_BOUNDS if over else CellStatus.CONVERGED).value
+        reason = "; ".join(over)
+    return {"index": index, **cell, "status": status, "reason": reason,
+            "reason_key": reason_key(status, reason), **info,
+            "elapsed": time.perf_counter() - start}
+
+
+def scene_bounds(scene: Scene, elements: int) -> dict:
+    """stability.BOUNDS with the slip start's (in metres) scaled to the grid.
+
+    The paper's 5 mm on 1000 elements over 1 m is five mean element lengths: the slip
+    start sits on element boundaries (its error jumps between 4e-6 and 1e-3 m there), so
+    its bound is 5 L / N. Measured on random scene 56 of seed 1 (L = 42.5 m, 1000
+    elements of 42 mm on average): 9.8 mm, 0.23 of a mean element, out of the paper's
+    bound. The relative bounds stay: they hold on the default grid, which resolves the
+    scene's shortest decay length as it does the paper's.
+    """
+    out = dict(BOUNDS)
+    out["slip_start"] = BOUNDS["slip_start"] * scene.params.L * (PAPER_ELEMENTS / elements)
+    return out
+
+
+def describe(scene: Scene, extra=()) -> dict:
+    """What a failure is usually about: friction, inertia, damping, v/c - 1, c / c_low
+    (0 without inertia) and the grid."""
+    P = scene.params
+    return {"friction": P.friction, "inertia": int(P.inertia), "damping": P.damping,
+            "mismatch": P.e0, "speed_ratio": P.c / min(P.critical_speeds),
+            "elements": _elements(scene, extra)}
+
+
+def _elements(scene, extra) -> int:
+    from ..solvers.settings import default_elements
+    for item in extra:
+        if item.startswith("numerics.elements="):
+            return int(item.split("=", 1)[1])
+    return scene.numerics.get("elements", default_elements(scene.params))
+
+
+#: Schemes that run in a second pass, on the scenes the first reached: a fixed step costs
+#: up to numerics.max_work node-steps (minutes) a cell, and run first they would spend a
+#: --max-wall on a few scenes and leave the rest untried by every scheme. The first pass
+#: stops at FIRST_PASS_SHARE of --max-wall, so the second has a share too.
+DEFERRED = ("explicit",)
+FIRST_PASS_SHARE = 0.5
+
+
+def random_study(n: int, seed: int, schemes=None, extra=(), max_wall=None, progress=None,
+                 on_failure=None) -> list[dict]:
+    """Every drawn scene by every registered scheme, one row per cell in scene order.
+
+    The schemes of DEFERRED run in a second pass over the scenes the first pass reached.
+    Cells not started within max_wall seconds are `skipped`, and so are the cell under way
+    and the rest after a Ctrl-C (reason INTERRUPTED), so that what ran is still reported.
+    on_failure(scene, rows) is called at each failed cell with the scene's rows so far.
+    """
+    start, stop = time.perf_counter(), ""
+    schemes = tuple(schemes or solvers.names())
+    scenes = [draw_scene(seed, i) for i in range(n)]
+    done: dict[tuple[int, str], dict] = {}
+    first = [s for s in schemes if s not in DEFERRED]
+    second = [s for s in schemes if s in DEFERRED]
+    reached = n
+    for group, share in ((first, FIRST_PASS_SHARE if second else 1.0), (second, 1.0)):
+        if stop != INTERRUPTED:
+            stop = ""
+        for i, scene in enumerate(scenes):
+            for scheme in group:
+                spent = time.perf_counter() - start
+                if max_wall is not None and spent > share * max_wall and not stop:
+                    stop = f"--max-wall {max_wall:g} s: {share * max_wall:g} s spent"
+                    if group is first:  # the second pass runs on the scenes begun
+                        reached = i if scheme == group[0] else i + 1
+                if i >= reached and not stop:
+                    stop = f"--max-wall {max_wall:g} s: scene not reached by {first[0]} ..."
+                if not stop:
+                    try:
+                        row = random_cell(scene, i, scheme, extra)
+                    except KeyboardInterrupt:
+                        stop = INTERRUPTED
+                if stop:
+                    row = {"index": i, "scheme": scheme, "status": SKIPPED, "reason": stop,
+                           "reason_key": "", **describe(scene, extra), "dt": math.nan,
+                           "steps": 0, "wall_time": math.nan, "elapsed": 0.0,
+                           **{f"error_{k}": math.nan for k in ERROR_KEYS}}
+                done[i, scheme] = row
+                if progress:
+                    progress(row)
+                if on_failure and failed(row):
+                    on_failure(scene, [done[i, s] for s in schemes if (i, s) in done])
+    return [done[i, s] for i in range(n) for s in schemes]
+
+
+def failure_scene(scene: Scene, rows, extra=()) -> Scene:
+    """The scene to rerun with `beltsim run FILE`: the grid as run, the failures named."""
+    bad = "; ".join(f"{r['scheme']}: {r['status']}" for r in rows if failed(r))
+    return scene.with_overrides([*extra, ("title", f"{scene.title}; failed: {bad}")])
+
+
+def counts(rows) -> dict:
+    """Cells by status, and by status and reason key for refusals and failures."""
+    by_status = Counter(r["status"] for r in rows)
+    by_reason = Counter((r["status"], r["reason_key"]) for r in rows
+                        if r["status"] == CellStatus.REFUSED.value or failed(r))
+    return {"status": dict(by_status), "reason": dict(by_reason)}
+
+
+def random_markdown(rows, seed: int, n: int, wall: float, extra=()) -> str:
+    """Counts per status and per scheme, refusals and failures by key, the failed cells."""
+    c = counts(rows)
+    schemes = list(dict.fromkeys(r["scheme"] for r in rows))
+    statuses = [s.value for s in CellStatus] + [CRASHED, SKIPPED]
+    statuses = [s for s in statuses if s in c["status"]]
+    grid = ", ".join(extra) if extra else "the default grid"
+    relative = ", ".join(f"{k} {b:g}" for k, b in BOUNDS.items() if k != "slip_start")
+    lines = [f"# Random scenes: {n} drawn with seed {seed}, on {grid}", "",
+             (f"{len(rows)} cells in {wall:.0f} s wall; {sum(failed(r) for r in rows)} "
+              f"failed. Bounds: {relative} (relative), slip start "
+              f"{BOUNDS['slip_start'] * PAPER_ELEMENTS:g} L / N (N elements)."), "",
+             "| scheme | " + " | ".join(statuses) + " |", "|---|" + "---|" * len(statuses)]
+    for scheme in schemes + ["all"]:
+        mine = Counter(r["status"] for r in rows if scheme in ("all", r["scheme"]))
+        lines.append(f"| {scheme} | " + " | ".join(str(mine.get(s, 0)) for s in statuses)
+                     + " |")
+    lines += ["", "| status | reason key | cells |", "|---|---|---|"]
+    for (status, key), k in sorted(c["reason"].items(), key=lambda kv: (-kv[1], kv[0])):
+        lines.append(f"| {status} | {key.replace('|', '/')} | {k} |")
+    bad = [r for r in rows if failed(r)]
+    if bad:
+        lines += ["", "Failed cells (scene files in failures/):", "",
+                  "| scene | scheme | status | elements | wall [s] | reason |",
+                  "|---|---|---|---|---|---|"]
+        for r in bad:
+            lines.append(f"| {r['index']} | {r['scheme']} | {r['status']} | {r['elements']} "
+                         f"| {r['elapsed']:.3g} | {r['reason'].replace('|', '/')} |")
+    return "\n".join(lines) + "\n"

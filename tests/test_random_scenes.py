@@ -1,0 +1,169 @@
+"""`beltsim stability --random`: the draw is valid and reproducible, the CLI counts add up."""
+
+import csv
+import math
+import tomllib
+
+import numpy as np
+from helpers import cli
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from beltsim import solvers
+from beltsim.problem import analytic
+from beltsim.problem.scene import Scene, load_scene, runs_dir
+from beltsim.solvers.settings import resolve
+from beltsim.studies import random_scenes as rs
+from beltsim.studies.stability import ACCEPTED, CellStatus
+
+
+@settings(max_examples=300, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), index=st.integers(0, 10**6))
+def test_every_drawn_scene_is_valid_and_runs_as_drawn(seed, index):
+    scene = rs.draw_scene(seed, index)
+    P = scene.params
+    # the file written for a failure reads back as the same scene
+    again = Scene.from_dict(tomllib.loads(scene.to_toml()))
+    assert again.to_dict() == scene.to_dict()
+    # the stability case built from it (a shipped scene, every key overridden) is it
+    case = rs.scene_case(scene)
+    assert load_scene(runs_dir() / f"{case.base}.toml", case.overrides).to_dict() == \
+        scene.to_dict()
+    assert 0.0 < P.x1 < P.x2 < P.L and -1.0 < scene.to_dict()["beam"]["poisson_ratio"] < 0.5
+    assert 1e-6 * (1 - 1e-6) <= abs(P.e0) <= 0.05 * (1 + 1e-6)
+    if P.inertia:
+        assert P.c <= 0.95 * min(P.critical_speeds) * (1 + 1e-5)
+    # the numerics resolve (mismatch, regularisation, memory) for every applicable scheme
+    for scheme in solvers.names():
+        if not solvers.applicable(scheme, P.inertia):
+            resolve(scene.with_overrides([f"numerics.integrator={scheme}"]))
+
+
+def test_the_draw_covers_the_space():
+    """Both frictions, inertia on and off, damped and undamped, both signs of v - c over
+    the decades, whole-contact sliding, poisson_ratio near both ends, near-critical."""
+    scenes = rs.draw_scenes(200, seed=11)
+    P = [s.params for s in scenes]
+    e = np.array([p.e0 for p in P])
+    assert (e > 0).any() and (e < 0).any()
+    assert np.abs(e).min() < 1e-5 and np.abs(e).max() > 1e-2
+    assert {p.friction for p in P} == {"stick", "coulomb"}
+    assert {p.inertia for p in P} == {True, False}
+    inertial = [p for p in P if p.inertia]
+    assert any(p.damping == 0 for p in inertial) and any(p.damping > 0 for p in inertial)
+    assert max(p.c / min(p.critical_speeds) for p in inertial) > 0.9
+    assert min(p.c / min(p.critical_speeds) for p in inertial) < 0.01
+    nu = [s.to_dict()["beam"]["poisson_ratio"] for s in scenes]
+    assert min(nu) < -0.9 and max(nu) > 0.45
+    slip = [analytic.solve(p) for p in P if p.friction == "coulomb"]
+    whole = [s for s in slip if s.x_star == s.params.x1]
+    assert 0 < len(whole) < len(slip)
+    fstar = [p.fstar for p in P if p.friction == "coulomb"]
+    assert max(fstar) / min(fstar) > 1e4
+
+
+def test_the_same_seed_draws_the_same_scenes():
+    a = [s.to_toml() for s in rs.draw_scenes(6, seed=5)]
+    assert a == [s.to_toml() for s in rs.draw_scenes(6, seed=5)]
+    # scene i does not depend on how many are drawn
+    assert rs.draw_scene(5, 4).to_toml() == a[4]
+    assert a != [s.to_toml() for s in rs.draw_scenes(6, seed=6)]
+
+
+def test_reasons_are_grouped_by_the_key_they_name():
+    assert rs.reason_key("refused", "numerics.max_work: this explicit run may need 4e10") == \
+        "numerics.max_work"
+    assert rs.reason_key(CellStatus.REFUSED, "contact.start/end: the contact must") == \
+        "contact.start/end"
+    assert rs.reason_key("out of bounds", "u 0.03 > 0.02; theta 0.5 > 0.02") == "u, theta"
+    assert rs.reason_key("diverged", "theta grew without bound at t = 50.2 s (1.03e+04 "
+                         "times its scale)") == rs.reason_key(
+        "diverged", "theta grew without bound at t = 4.1 s (1.1e+04 times its scale)")
+
+
+def test_a_few_random_scenes_through_the_cli(tmp_path):
+    """A coarse grid (60 elements): out of bounds is expected there; the files and the
+    counts must agree with each other and with the exit status."""
+    n, out = 4, tmp_path / "r"
+    (out / "failures").mkdir(parents=True)
+    (out / "failures" / "scene_99.toml").write_text("stale")  # a previous draw's
+    proc = cli("stability", "--random", n, "--seed", 3, "--elements", 60, "--out", out,
+               timeout=900)
+    rows = list(csv.DictReader((out / "random.csv").open()))
+    assert len(rows) == n * len(solvers.names())
+    assert {(int(r["index"]), r["scheme"]) for r in rows} == {
+        (i, s) for i in range(n) for s in solvers.names()}
+    known = {s.value for s in CellStatus} | {rs.CRASHED}
+    assert {r["status"] for r in rows} <= known
+    for r in rows:
+        assert int(r["elements"]) == 60
+        if r["status"] != "converged":
+            assert r["reason"], r
+        if r["status"] in ("converged", "out of bounds"):
+            assert math.isfinite(float(r["error_total_friction"]))
+    failed = {int(r["index"]) for r in rows if r["status"] not in {s.value for s in ACCEPTED}}
+    files = sorted(p.name for p in (out / "failures").glob("*.toml"))
+    assert files == sorted(f"scene_{i}.toml" for i in failed)
+    for i in failed:  # each reruns as drawn, on the grid it ran on
+        scene = Scene.load(out / "failures" / f"scene_{i}.toml")
+        assert scene.numerics == {"elements": 60}
+        drawn = rs.draw_scene(3, i).to_dict()
+        got = scene.to_dict()
+        assert got.pop("title").startswith(drawn.pop("title") + "; failed: ")
+        got.pop("numerics")
+        assert got == drawn
+    md = (out / "random.md").read_text()
+    total = next(line for line in md.splitlines() if line.startswith("| all |"))
+    counts = {s: sum(r["status"] == s for r in rows) for s in known}
+    header = next(line for line in md.splitlines() if line.startswith("| scheme |"))
+    cols = [c.strip() for c in header.strip("|").split("|")][1:]
+    assert dict(zip(cols, map(int, total.strip("|").split("|")[1:]))) == {
+        c: counts[c] for c in cols}
+    assert sum(counts.values()) == len(rows)
+    assert f"{len(rows)} cells" in proc.stdout
+    assert proc.returncode == (1 if failed else 0), proc.stderr
+
+
+def test_max_wall_skips_the_cells_not_started(tmp_path):
+    proc = cli("stability", "--random", 3, "--seed", 3, "--elements", 60, "--max-wall",
+               1e-9, "--out", tmp_path)
+    rows = list(csv.DictReader((tmp_path / "random.csv").open()))
+    assert proc.returncode == 0, proc.stderr
+    assert {r["status"] for r in rows} == {rs.SKIPPED}
+    assert len(rows) == 3 * len(solvers.names()) and f"skipped {len(rows)}" in proc.stdout
+
+
+def test_bad_random_options_are_one_line_errors(tmp_path):
+    for args in (["--random", 0], ["--seed", 3], ["--random", 2, "--max-wall", -1]):
+        proc = cli("stability", *args, "--out", tmp_path)
+        assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+
+
+def test_the_slip_start_bound_scales_with_the_grid():
+    from beltsim.problem.scene import paper_scene
+    from beltsim.studies.stability import BOUNDS
+    assert rs.scene_bounds(paper_scene("slip"), 1000) == BOUNDS  # what BOUNDS were set on
+    long = paper_scene("slip", ["beam.length=40", "contact.start=10", "contact.end=30"])
+    assert rs.scene_bounds(long, 2000)["slip_start"] == 40 * BOUNDS["slip_start"] / 2
+    assert rs.scene_bounds(long, 2000)["theta"] == BOUNDS["theta"]
+
+
+def test_the_deferred_schemes_get_their_share_of_max_wall(monkeypatch):
+    """The adaptive schemes stop at FIRST_PASS_SHARE of --max-wall; the deferred ones run
+    on the scenes the first pass reached, then are skipped too."""
+    import time
+
+    def fake(scene, i, scheme, extra):
+        time.sleep(0.2 if scheme in rs.DEFERRED else 0.05)
+        return {"index": i, "scheme": scheme, "status": "converged", "reason": "",
+                "reason_key": "", **rs.describe(scene), "elapsed": 0.0}
+    monkeypatch.setattr(rs, "random_cell", fake)
+    rows = rs.random_study(40, 1, max_wall=2.0)
+    assert [(r["index"], r["scheme"]) for r in rows] == [
+        (i, s) for i in range(40) for s in solvers.names()]
+    ran = {(r["index"], r["scheme"]) for r in rows if r["status"] != rs.SKIPPED}
+    first = {i for i, s in ran if s not in rs.DEFERRED}
+    deferred = {i for i, s in ran if s in rs.DEFERRED}
+    assert first and deferred and max(deferred) <= max(first) < 39
+    assert all(r["reason"].startswith("--max-wall 2 s") for r in rows
+               if r["status"] == rs.SKIPPED)
