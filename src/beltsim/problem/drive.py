@@ -108,9 +108,9 @@ def _profile(raw, offset: float, scale: float, ramp_time: float) -> Profile:
 
 def drive_of(scene, ramp_time: float) -> Drive:
     """The scene's drive; ``ramp_time`` is the speed ramp (numerics.ramp_time)."""
-    data, P = scene.to_dict(), scene.params
-    speed = _profile(data["motion"]["surface_speed"], P.c, 1.0, ramp_time)
-    raw = data["contact"].get("max_friction")
+    P = scene.params
+    raw_speed, raw = _profiles(scene)
+    speed = _profile(raw_speed, P.c, 1.0, ramp_time)
     friction = Profile.constant(1.0) if raw is None else _profile(raw, 0.0, P.fstar, 0.0)
     return Drive(speed, friction)
 

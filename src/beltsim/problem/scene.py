@@ -34,16 +34,15 @@ class _Rule:
 
     def check(self, key, value):
         if self.kind in ("float", "int"):
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise SceneError(f"{key}: must be a number, got {_show(value)}")
-            if self.kind == "int":
+            if self.kind == "float":
+                value = _number(key, value)
+            else:
+                if isinstance(value, bool) or not isinstance(value, (int, float)):
+                    raise SceneError(f"{key}: must be a number, got {_show(value)}")
                 if isinstance(value, float):
                     if not (math.isfinite(value) and value == int(value)):
                         raise SceneError(f"{key}: must be a whole number, got {_show(value)}")
                     value = int(value)
-            value = value if self.kind == "int" else float(value)
-            if not math.isfinite(value):
-                raise SceneError(f"{key}: must be finite, got {_show(value)}")
             if self.positive and not value > 0:
                 raise SceneError(f"{key}: must be > 0, got {_show(value)}")
             if self.nonneg and not value >= 0:
@@ -76,6 +75,7 @@ SINE_KEYS = ("mean", "amplitude", "period")
 
 
 def _number(key, value):
+    """A finite number as a float, or the one-line error of a float key."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise SceneError(f"{key}: must be a number, got {_show(value)}")
     if not math.isfinite(value):

@@ -178,8 +178,8 @@ class Simulation:
                     # checks on a fixed grid k * check: a scheme that steps past a
                     # check (explicit, fixed dt) does not drift from it
                     t_next = self.check * (math.floor(self.t / self.check + 1e-9) + 1)
-                    k = np.searchsorted(self.breaks, self.t * (1 + 1e-12) + 1e-300,
-                                        side="right")
+                    # the next table row after t (one within round-off of t is passed)
+                    k = np.searchsorted(self.breaks, self.t + 1e-9 * self.check, side="right")
                     if k < self.breaks.size and self.breaks[k] < t_next - 1e-9 * self.check:
                         t_next = self.breaks[k]
                     # the last chunk absorbs a round-off remainder rather than leave a sliver
