@@ -62,7 +62,7 @@ def write_snapshots(path, result) -> Path:
     buf = io.BytesIO()
     np.savez_compressed(buf, x=sol.x, t=snaps["t"], u=snaps["u"].astype(np.float32),
                         theta=snaps["theta"].astype(np.float32),
-                        friction=traction(snaps["fnode"], sol.grid.he).astype(np.float32),
+                        friction=traction(snaps["fnode"], sol.wf).astype(np.float32),
                         scene=np.array(result.scene.to_toml()))
     return write_atomic(path, buf.getvalue())
 

@@ -59,12 +59,20 @@ class ModelParams(NamedTuple):
 
 
 class Mesh(NamedTuple):
-    """The grid as the kernels read it."""
+    """The grid as the kernels read it, with the contact's friction stencil.
+
+    Friction acts at the contact nodes c0..j2: node j carries the nodal force
+    F_j = -wf_j f_s lam_j, lam_j the friction ratio of its slip velocity
+    v_rel,j = d/dt u_b,j + c sum_o sw[j, o] u_b,{j-2+o} - (v - c) (offsets -2..+1).
+    """
 
     he: np.ndarray  # element lengths (N)
     hb: np.ndarray  # nodal control-volume lengths (N + 1)
     j1: int  # node at x1
     j2: int  # node at x2
+    c0: int  # first friction node
+    wf: np.ndarray  # friction weight (m) of each node (N + 1), 0 off the friction nodes
+    sw: np.ndarray  # d/dx u_b at node j: weights of u_b at j-2, j-1, j, j+1 (N + 1, 4)
 
 
 class State(NamedTuple):
@@ -156,8 +164,67 @@ def model_params(P, damping, friction_scale, v_reg, law_code) -> ModelParams:
         v_reg=v_reg, law=law_code, dual=dual)
 
 
-def mesh_of(grid) -> Mesh:
-    return Mesh(grid.he, grid.hbar, grid.j1, grid.j2)
+# How the transport c d/dx u_b of the slip velocity is discretised (contact_stencil).
+TRANSPORT = "bdf2"
+TRANSPORTS = ("upwind", "bdf2", "central")
+
+
+def contact_stencil(x, j1, j2, kind=None):
+    """(c0, wf, sw) of the contact [x_j1, x_j2] on the nodes x (see :class:`Mesh`).
+
+    * "upwind" (first order): the slip velocity of element [x_{j-1}, x_j] with its
+      strain, lumped on node j (c0 = j1 + 1, wf_j = h_{j-1});
+    * "bdf2" (second order): the slip velocity at node j with the one-sided
+      three-point derivative over x_{j-2}, x_{j-1}, x_j (exact for quadratics on any
+      grid), its friction on the contact part of node j's control volume (c0 = j1,
+      half volumes at x1 and x2: trapezoidal quadrature). The homogeneous solutions
+      of 3-point upwind differences are 1 and (h1/(h1+h2))^2-ish ~ 1/3 per node
+      downstream: no odd-even mode;
+    * "central" (for the oscillation test): (u_b,{j+1} - u_b,{j-1}) / (x_{j+1} -
+      x_{j-1}) with trapezoidal weights; decouples odd and even nodes.
+    """
+    kind = TRANSPORT if kind is None else kind
+    x = np.asarray(x, dtype=float)
+    N = len(x) - 1
+    he = np.diff(x)
+    wf = np.zeros(N + 1)
+    sw = np.zeros((N + 1, 4))
+    if kind == "upwind":
+        c0 = j1 + 1
+        for j in range(c0, j2 + 1):
+            wf[j] = he[j - 1]
+            sw[j, 1], sw[j, 2] = -1.0 / he[j - 1], 1.0 / he[j - 1]
+        return c0, wf, sw
+    if kind not in TRANSPORTS:
+        raise ValueError(f"unknown transport discretisation {kind!r}")
+    c0 = j1
+    for j in range(j1, j2 + 1):
+        wf[j] = 0.5 * ((he[j - 1] if j > j1 else 0.0) + (he[j] if j < j2 else 0.0))
+        if kind == "bdf2":
+            h1, h2 = he[j - 1], he[j - 2]
+            sw[j, 0] = h1 / (h2 * (h1 + h2))
+            sw[j, 1] = -(h1 + h2) / (h1 * h2)
+            sw[j, 2] = (2.0 * h1 + h2) / (h1 * (h1 + h2))
+        else:
+            d = he[j - 1] + he[j]
+            sw[j, 1], sw[j, 3] = -1.0 / d, 1.0 / d
+    return c0, wf, sw
+
+
+def mesh_of(grid, kind=None) -> Mesh:
+    c0, wf, sw = contact_stencil(grid.x, grid.j1, grid.j2, kind)
+    return Mesh(grid.he, grid.hbar, grid.j1, grid.j2, c0, wf, sw)
+
+
+@njit(cache=True)
+def bottom_strain(u, th, hh, sw, j):
+    """d/dx u_b at friction node j from the stencil weights sw[j]."""
+    e = 0.0
+    for o in range(4):
+        k = j - 2 + o
+        if sw[j, o] != 0.0:
+            e += sw[j, o] * (u[k] + hh * th[k])
+    return e
 
 
 @njit(cache=True)
@@ -181,8 +248,10 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
     damp, vreg = p.damping, p.v_reg
     fs = p.friction_scale * friction_factor(drive, t)
     he, hb, j1, j2 = mesh.he, mesh.hb, mesh.j1, mesh.j2
+    c0, wf, sw = mesh.c0, mesh.wf, mesh.sw
     uo, tho, udo, tdo = old.u, old.theta, old.ud, old.td
     R, Lb, Db, Ub, rl, sg = w.R, w.Lb, w.Db, w.Ub, w.rl, w.sg
+    L2 = w.L2
     target = mismatch(drive, t)
     lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
     code, dual = p.law, p.dual
@@ -210,6 +279,7 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
             for a_ in range(2):
                 for b_ in range(2):
                     Lb[i, a_, b_] = 0.0
+                    L2[i, a_, b_] = 0.0
                     Db[i, a_, b_] = 0.0
                     Ub[i, a_, b_] = 0.0
             Db[i, 0, 0] = rho * hbj * kin + rho * gyro * inv_dt + B * (1.0 / hl + 1.0 / hr)
@@ -219,12 +289,11 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
                            + b2 * hbj)
             Lb[i, 1, 1] = -I * gyro * inv_dt - A / hl
             Ub[i, 1, 1] = -A / hr
-        if j > j1 and j <= j2:
-            # element [j-1, j]: upwind strain, velocity of the downstream node
+        if j >= c0 and j <= j2:
+            # slip velocity at node j (stencil sw[j]), friction on its weight wf[j]
             ub = u[j] + hh * th[j]
-            ub_l = u[j - 1] + hh * th[j - 1]
             ubo = uo[j] + hh * tho[j]
-            vrel = (ub - ubo) * inv_dt + c * (ub - ub_l) / hl - target
+            vrel = (ub - ubo) * inv_dt + c * bottom_strain(u, th, hh, sw, j) - target
             if dual:
                 gi, dgi = law_inverse(code, lam[j])
                 rl[j] = vrel / vreg - gi
@@ -232,21 +301,30 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
             else:
                 lam[j], sg[j] = law(code, vrel / vreg)
                 rl[j] = 0.0
-            fnode[j] = -hl * fs * lam[j]
-            ru += hl * fs * (lam[j] + sg[j] * rl[j])
-            rt += hh * hl * fs * (lam[j] + sg[j] * rl[j])
+            wj = wf[j]
+            fnode[j] = -wj * fs * lam[j]
+            ru += wj * fs * (lam[j] + sg[j] * rl[j])
+            rt += hh * wj * fs * (lam[j] + sg[j] * rl[j])
             if want_jac:
-                k = hl * fs * sg[j] / vreg  # -dF/dv_rel
-                dd = k * (inv_dt + c / hl)
-                dl = -k * c / hl
-                Db[i, 0, 0] += dd
-                Db[i, 0, 1] += dd * hh
-                Db[i, 1, 0] += dd * hh
-                Db[i, 1, 1] += dd * hh * hh
-                Lb[i, 0, 0] += dl
-                Lb[i, 0, 1] += dl * hh
-                Lb[i, 1, 0] += dl * hh
-                Lb[i, 1, 1] += dl * hh * hh
+                k = wj * fs * sg[j] / vreg  # -dF/dv_rel
+                for o in range(4):
+                    dd = k * c * sw[j, o]
+                    if o == 2:
+                        dd += k * inv_dt
+                    if dd == 0.0:
+                        continue
+                    if o == 0:
+                        blk = L2
+                    elif o == 1:
+                        blk = Lb
+                    elif o == 2:
+                        blk = Db
+                    else:
+                        blk = Ub
+                    blk[i, 0, 0] += dd
+                    blk[i, 0, 1] += dd * hh
+                    blk[i, 1, 0] += dd * hh
+                    blk[i, 1, 1] += dd * hh * hh
         R[i, 0] = ru
         R[i, 1] = rt
 
@@ -260,13 +338,18 @@ def update_multipliers(lam, dx, inv_dt, mesh, p, w):
     Returns the largest change.
     """
     c, hh, vreg = p.speed, p.half_height, p.v_reg
-    he, rl, sg = mesh.he, w.rl, w.sg
+    rl, sg, sw = w.rl, w.sg, mesh.sw
+    n = dx.shape[0]
     big = 0.0
-    for j in range(mesh.j1 + 1, mesh.j2 + 1):
-        hl = he[j - 1]
-        dub = dx[j - 1, 0] + hh * dx[j - 1, 1]
-        dub_l = dx[j - 2, 0] + hh * dx[j - 2, 1] if j >= 2 else 0.0
-        dvrel = (inv_dt + c / hl) * dub - (c / hl) * dub_l
+    for j in range(mesh.c0, mesh.j2 + 1):
+        dvrel = 0.0
+        for o in range(4):
+            k = j - 2 + o
+            if 1 <= k <= n:
+                dub = dx[k - 1, 0] + hh * dx[k - 1, 1]
+                dvrel += c * sw[j, o] * dub
+                if o == 2:
+                    dvrel += inv_dt * dub
         dl = sg[j] * (rl[j] + dvrel / vreg)
         if lam[j] + dl >= 1.0:
             dl = 0.99 * (1.0 - lam[j])
@@ -323,13 +406,15 @@ def block_solve(Lb, Db, Ub, r, x, C):
     return True
 
 
-def traction(fnode, he):
-    """Element traction f (N/m) at each node (of the element upstream), 0 off contact.
+def traction(fnode, wf):
+    """Traction f (N/m) at each friction node: F_j / wf_j, 0 off contact.
 
-    Works on stacks of states (last axis: nodes).
+    wf: the friction weights of :class:`Mesh` (contact_stencil). Works on stacks of
+    states (last axis: nodes).
     """
     f = np.zeros_like(fnode)
-    f[..., 1:] = fnode[..., 1:] / he
+    on = wf > 0.0
+    f[..., on] = fnode[..., on] / wf[on]
     return f
 
 
@@ -356,8 +441,8 @@ def power_terms(state, t, mesh, p, drive, loads, out):
     surface = 0.0
     transport = 0.0
     slip = 0.0
-    for j in range(mesh.j1 + 1, mesh.j2 + 1):
-        strain_b = (u[j] + hh * th[j] - u[j - 1] - hh * th[j - 1]) / he[j - 1]
+    for j in range(mesh.c0, mesh.j2 + 1):
+        strain_b = bottom_strain(u, th, hh, mesh.sw, j)
         vrel = ud[j] + hh * td[j] + c * strain_b - target
         surface += target * F[j]
         transport -= c * F[j] * strain_b
@@ -394,6 +479,11 @@ def stored_energy(state, mesh: Mesh, p: ModelParams) -> float:
 # numpy twins (tests, the bench's peer)
 
 
+def strain_numpy(ub, sw, j):
+    """d/dx u_b at the friction nodes j (array) from the stencil weights sw."""
+    return sum(sw[j, o] * ub[np.minimum(j - 2 + o, len(ub) - 1)] for o in range(4))
+
+
 def forces_numpy(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, loads=None):
     """Nodal forces and moments of the semi-discrete model, all but the inertia terms.
 
@@ -407,10 +497,10 @@ def forces_numpy(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, loads=None
     he, hb = mesh.he, mesh.hb
     ub = u + hh * th
     F = np.zeros_like(u)
-    j = np.arange(mesh.j1 + 1, mesh.j2 + 1)
-    vrel = ud[j] + hh * td[j] + c * (ub[j] - ub[j - 1]) / he[j - 1] - mismatch(drive, t)
+    j = np.arange(mesh.c0, mesh.j2 + 1)
+    vrel = ud[j] + hh * td[j] + c * strain_numpy(ub, mesh.sw, j) - mismatch(drive, t)
     fs = p.friction_scale * friction_factor(drive, t)
-    F[j] = -he[j - 1] * fs * law_numpy(p.law, vrel / p.v_reg)[0]
+    F[j] = -mesh.wf[j] * fs * law_numpy(p.law, vrel / p.v_reg)[0]
     sl = slice(1, -1)
     gyro = 2.0 * c * hb[sl] / he[:-1]
     fu = (B * np.diff(np.diff(u) / he) - rho * gyro * (ud[sl] - ud[:-2])
@@ -438,12 +528,14 @@ def residual_numpy(u, th, old: State, inv_dt, t, mesh: Mesh, p: ModelParams, dri
     return np.column_stack([ru, rt]), F
 
 
-def blocks_to_dense(Lb, Db, Ub):
-    """Dense matrix of a block-tridiagonal Jacobian (tests)."""
+def blocks_to_dense(Lb, Db, Ub, L2=None):
+    """Dense matrix of a block-banded Jacobian (tests): L2 the second lower band."""
     n = Db.shape[0]
     J = np.zeros((2 * n, 2 * n))
     for i in range(n):
         J[2 * i:2 * i + 2, 2 * i:2 * i + 2] = Db[i]
+        if i > 1 and L2 is not None:
+            J[2 * i:2 * i + 2, 2 * i - 4:2 * i - 2] = L2[i]
         if i > 0:
             J[2 * i:2 * i + 2, 2 * i - 2:2 * i] = Lb[i]
         if i < n - 1:

@@ -2,16 +2,19 @@
 
 How the analytic quantities are read off the discrete state:
 
-* the nodal friction forces F_j (N) are the element tractions lumped on the
-  downstream node; ``total_friction`` is their sum;
-* perfect adhesion: the concentrated force is what the last three contact
-  elements (ending at x2) carry beyond the distributed traction, which is
-  extrapolated linearly from the three elements upstream of them; the rest of
-  the total is distributed;
-* stick and slip: an element slides when |f| >= 0.99 f* (1 - 1e-12 for the ramp
-  law); ``slip_start`` x* is the upstream end of the run of sliding elements
-  that ends at x2 (x2 itself if the last element sticks); the friction of
-  sliding elements is ``slip_friction``, the rest ``stick_friction``.
+* the nodal friction forces F_j (N) sit on the friction nodes of the contact
+  (physics.model.contact_stencil), the traction f_j = F_j / wf_j;
+  ``total_friction`` is their sum;
+* perfect adhesion: the concentrated force is what node j2 (at x2) carries beyond
+  the distributed traction on its half control volume, extrapolated
+  (quadratic) from the three nodes upstream; the rest of the total is distributed;
+* stick and slip: a node slides when |f| >= 0.99 f* (1 - 1e-12 for the ramp
+  law); the run of sliding nodes that ends at x2 starts at node p + 1, and node p
+  is partly stuck: ``slip_start`` x* is read inside its control volume [a, b] from
+  F_p = f_stick (x* - a) + s f* (b - x*), f_stick the stick traction extrapolated
+  from upstream (x2 itself if node j2 sticks, x1 if every node slides); the
+  friction of sliding nodes and of node p's sliding part is ``slip_friction``, the
+  rest ``stick_friction``.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ import numpy as np
 
 from ..physics.friction import saturation
 from ..physics.grid import Grid
-from ..physics.model import traction
+from ..physics.model import contact_stencil, strain_numpy, traction
 from ..problem.analytic import AnalyticSolution
 from ..problem.scene import Params
 
@@ -45,9 +48,6 @@ def relative_error(value, exact) -> float:
     return abs(value - exact) / abs(exact) if exact != 0 else abs(value - exact)
 
 
-LAYER, FIT = 3, 3  # elements of the discrete force layer at x2, and of the smooth fit
-
-
 class DiscreteSolution:
     def __init__(self, params: Params, grid: Grid, u, theta, fnode, law_code, fs, ud=None,
                  td=None, mismatch=None):
@@ -64,6 +64,8 @@ class DiscreteSolution:
         self.fs = fs
         # v(t) - c at the state's time (the drive's final value by default)
         self.mismatch = params.v - params.c if mismatch is None else float(mismatch)
+        # the friction nodes, their weights and slip-velocity stencils (physics.model)
+        self.c0, self.wf, self.sw = contact_stencil(grid.x, grid.j1, grid.j2)
 
     @property
     def x(self):
@@ -71,7 +73,7 @@ class DiscreteSolution:
 
     @property
     def traction(self) -> np.ndarray:
-        return traction(self.fnode, self.grid.he)
+        return traction(self.fnode, self.wf)
 
     def fields(self) -> dict:
         """Nodal fields with the analytic header: strain and moment averaged from elements."""
@@ -86,21 +88,63 @@ class DiscreteSolution:
         return float(self.fnode.sum())
 
     def _sliding(self):
-        """Boolean per node: the element upstream of the node slides."""
-        g = np.abs(self.fnode[1:] / self.grid.he) / self.fs
+        """Boolean per node: the friction node slides (|f| >= saturation f*)."""
         s = np.zeros_like(self.fnode, dtype=bool)
-        s[1:] = g >= saturation(self.law_code)
-        s[: self.grid.j1 + 1] = False
-        s[self.grid.j2 + 1:] = False
+        on = self.wf > 0.0
+        s[on] = np.abs(self.fnode[on] / self.wf[on]) / self.fs >= saturation(self.law_code)
         return s
+
+    def _control_volume(self, j):
+        """The contact part [a, b] of node j's control volume."""
+        x, g = self.grid.x, self.grid
+        a = x[j] if j == g.j1 else 0.5 * (x[j - 1] + x[j])
+        b = x[j] if j == g.j2 else 0.5 * (x[j] + x[j + 1])
+        return a, b
+
+    def _stick_traction_at(self, p, xq):
+        """The stick traction extrapolated to xq from the three friction nodes before p
+        (quadratic; fewer near x1)."""
+        k = np.arange(max(self.c0, p - 3), p)
+        f = self.traction
+        if len(k) == 0:
+            return 0.0
+        if len(k) == 1:
+            return float(f[k[0]])
+        return float(np.polyval(np.polyfit(self.grid.x[k], f[k], len(k) - 1), xq))
+
+    def _slip_front(self):
+        """(x*, p): the slip start read inside the cell, and the node whose control volume
+        holds it (None when no node slides).
+
+        The friction nodes from p + 1 to x2 slide; node p, upstream of them, is
+        partly stuck: its force F_p = f_stick (x* - a) + s f* (b - x*) over the contact
+        part [a, b] of its control volume, f_stick the stick traction extrapolated
+        from the nodes upstream of p, gives x* (clipped to [a, b]).
+        """
+        sl = self._sliding()
+        g = self.grid
+        j = g.j2
+        if not sl[j]:
+            return float(g.x[j]), None
+        while j > self.c0 and sl[j - 1]:
+            j -= 1
+        if j == self.c0:
+            return float(g.x[g.j1]), None
+        p = j - 1
+        a, b = self._control_volume(p)
+        fslip = np.sign(self.fnode[g.j2]) * self.fs
+        xs = 0.5 * (a + b)
+        for _ in range(3):  # f_stick at the middle of [a, x*]
+            fst = self._stick_traction_at(p, 0.5 * (a + xs))
+            if fslip == fst:
+                break
+            xs = (self.fnode[p] - fslip * b + fst * a) / (fst - fslip)
+            xs = min(b, max(a, xs))
+        return float(xs), p
 
     @property
     def slip_start(self) -> float:
-        s = self._sliding()
-        j = self.grid.j2
-        while j > self.grid.j1 and s[j]:
-            j -= 1
-        return float(self.grid.x[j])
+        return self._slip_front()[0]
 
     @property
     def slip_power(self) -> float:
@@ -113,10 +157,10 @@ class DiscreteSolution:
         thinner than an element, does not show its dissipation here at all.
         """
         g, P = self.grid, self.params
-        j = np.arange(g.j1 + 1, g.j2 + 1)
+        j = np.arange(self.c0, g.j2 + 1)
         hh = 0.5 * P.h
         ub = self.u + hh * self.theta
-        vrel = (self.ud[j] + hh * self.td[j] + P.c * (ub[j] - ub[j - 1]) / g.he[j - 1]
+        vrel = (self.ud[j] + hh * self.td[j] + P.c * strain_numpy(ub, self.sw, j)
                 - self.mismatch)
         return float(-np.sum(self.fnode[j] * vrel))
 
@@ -139,23 +183,14 @@ class DiscreteSolution:
 
     @property
     def concentrated_force(self) -> float:
-        """Excess over a smooth traction in the last LAYER elements before x2.
+        """What node j2 (at x2) carries beyond the smooth traction on its half volume.
 
-        The discrete force is not all on the last element: the element before it
-        carries a little of it too (a discrete layer of one or two elements), so the
-        smooth traction is fitted on the FIT elements upstream of that layer.
+        The smooth traction at x2 is extrapolated (quadratic) from the three friction
+        nodes upstream of x2.
         """
-        g, f = self.grid, self.traction
-        last = g.j2 - 1  # element index; element e ends at node e + 1
-        layer = np.arange(max(g.j1, last - LAYER + 1), last + 1)
-        fit = np.arange(max(g.j1, layer[0] - FIT), layer[0])
-        xm = 0.5 * (g.x[1:] + g.x[:-1])
-        if len(fit) >= 2:
-            coef = np.polyfit(xm[fit], f[fit + 1], 1)
-            smooth = np.polyval(coef, xm[layer])
-        else:
-            smooth = np.full(len(layer), f[fit + 1].mean() if len(fit) else 0.0)
-        return float(np.sum(self.fnode[layer + 1] - smooth * g.he[layer]))
+        g = self.grid
+        smooth = self._stick_traction_at(g.j2, g.x[g.j2])
+        return float(self.fnode[g.j2] - smooth * self.wf[g.j2])
 
     def summary(self) -> dict:
         total = self.total_friction
@@ -165,12 +200,16 @@ class DiscreteSolution:
                     "concentrated_force": conc, "distributed_friction": total - conc,
                     "stick_friction": None, "slip_friction": None, "slip_start": None,
                     "slip_power": self.steady_slip_power}
+        xs, p = self._slip_front()
         s = self._sliding()
         slip = float(self.fnode[s].sum())
+        if p is not None:  # the sliding part of the partly stuck node
+            slip += float(np.sign(self.fnode[self.grid.j2]) * self.fs
+                          * (self._control_volume(p)[1] - xs))
         return {"model": "slip", "inertia": self.params.inertia, "total_friction": total,
                 "concentrated_force": None, "distributed_friction": None,
                 "stick_friction": total - slip, "slip_friction": slip,
-                "slip_start": self.slip_start, "slip_power": self.steady_slip_power}
+                "slip_start": xs, "slip_power": self.steady_slip_power}
 
 
 def compare(sim: DiscreteSolution, ref: AnalyticSolution) -> dict:

@@ -84,8 +84,8 @@ def filtered_error(e, a0, fs, mesh, p, w, out):
         gyro = a0 * 2.0 * c * hb[j] / he[j - 1]
         out[i, 0] = kin * rho * hb[j] * e[i, 0] + rho * gyro * (e[i, 0] - ul)
         out[i, 1] = kin * I * hb[j] * e[i, 1] + I * gyro * (e[i, 1] - tl)
-        if mesh.j1 < j <= mesh.j2:
-            k = he[j - 1] * fs * w.sgf[j] / p.v_reg * a0
+        if mesh.c0 <= j <= mesh.j2:
+            k = mesh.wf[j] * fs * w.sgf[j] / p.v_reg * a0
             eb = e[i, 0] + hh * e[i, 1]
             out[i, 0] += k * eb
             out[i, 1] += hh * k * eb
@@ -101,7 +101,7 @@ def predict_friction(lam, lam_prev, r, mesh):
     the bound wrongly is caught by Newton's check of the ratios at the bound
     (:func:`beltsim.solvers.newton.release_stuck_ratios`).
     """
-    for j in range(mesh.j1 + 1, mesh.j2 + 1):
+    for j in range(mesh.c0, mesh.j2 + 1):
         lam[j] = min(LAM_MAX, max(-LAM_MAX, lam[j] + r * (lam[j] - lam_prev[j])))
 
 

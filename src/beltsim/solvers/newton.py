@@ -52,10 +52,12 @@ class Workspace(NamedTuple):
 
     R: np.ndarray  # residual (n, 2), n = N - 1 interior nodes
     Lb: np.ndarray  # Jacobian blocks (n, 2, 2)
+    L2: np.ndarray  # second lower band (the friction stencil reaches node j - 2)
     Db: np.ndarray
     Ub: np.ndarray
     C: np.ndarray  # block LU of the Jacobian (block_factor): inverse pivots (n, 2, 2),
     W: np.ndarray  # multipliers,
+    W2: np.ndarray  # those of the second lower band,
     U: np.ndarray  # upper blocks (a line search assembles Ub anew)
     dx: np.ndarray  # Newton update (n, 2)
     u_try: np.ndarray  # line-search trial (N + 1)
@@ -69,8 +71,10 @@ class Workspace(NamedTuple):
     @classmethod
     def allocate(cls, n_elements: int) -> "Workspace":
         N, n = n_elements, n_elements - 1
-        return cls(R=np.zeros((n, 2)), Lb=np.zeros((n, 2, 2)), Db=np.zeros((n, 2, 2)),
+        return cls(R=np.zeros((n, 2)), Lb=np.zeros((n, 2, 2)), L2=np.zeros((n, 2, 2)),
+                   Db=np.zeros((n, 2, 2)),
                    Ub=np.zeros((n, 2, 2)), C=np.zeros((n, 2, 2)), W=np.zeros((n, 2, 2)),
+                   W2=np.zeros((n, 2, 2)),
                    U=np.zeros((n, 2, 2)), dx=np.zeros((n, 2)),
                    u_try=np.zeros(N + 1), th_try=np.zeros(N + 1), rl=np.zeros(N + 1),
                    sg=np.zeros(N + 1), sgf=np.zeros(N + 1), lam0=np.zeros(N + 1),
@@ -89,14 +93,16 @@ def merit(R, scales):
 
 @njit(cache=True, error_model="numpy")  # a zero pivot gives inf, and False, not an exception
 def block_factor(Lb, Db, Ub, w):
-    """Block LU of a block-tridiagonal matrix (2x2 blocks) for :func:`block_substitute`.
+    """Block LU of a block-banded matrix (2x2 blocks; two lower bands, L2 in w.L2, one
+    upper) for :func:`block_substitute`.
 
-    With the pivots S_0 = D_0, S_i = D_i - W_i U_{i-1}, W_i = L_i S_{i-1}^{-1}: w.C
+    With W2_i = L2_i S_{i-2}^{-1}, L'_i = L_i - W2_i U_{i-2}, the pivots S_0 = D_0,
+    S_i = D_i - W_i U_{i-1}, W_i = L'_i S_{i-1}^{-1} (no fill: upper band stays one): w.C
     receives the inverses S_i^{-1}, w.W the W_i, w.U a copy of the U_i. The factors
     serve two right-hand sides: the Newton update and the step's error estimate
     (implicit.filtered_error). Returns False on a singular pivot.
     """
-    C, W, U = w.C, w.W, w.U
+    C, W, U, W2, L2 = w.C, w.W, w.U, w.W2, w.L2
     n = Db.shape[0]
     q00 = q01 = q10 = q11 = 0.0  # S_{i-1}^{-1}
     regular = True  # (a flag, not a branch out of the loop: that costs a third of the time)
@@ -104,6 +110,22 @@ def block_factor(Lb, Db, Ub, w):
         s00, s01, s10, s11 = Db[i, 0, 0], Db[i, 0, 1], Db[i, 1, 0], Db[i, 1, 1]
         if i > 0:
             l00, l01, l10, l11 = Lb[i, 0, 0], Lb[i, 0, 1], Lb[i, 1, 0], Lb[i, 1, 1]
+            if i > 1:
+                # second band: W2_i = L2_i S_{i-2}^{-1}, L_i <- L_i - W2_i U_{i-2}
+                a00, a01, a10, a11 = L2[i, 0, 0], L2[i, 0, 1], L2[i, 1, 0], L2[i, 1, 1]
+                p00, p01, p10, p11 = C[i - 2, 0, 0], C[i - 2, 0, 1], C[i - 2, 1, 0], C[i - 2, 1, 1]
+                v00 = a00 * p00 + a01 * p10
+                v01 = a00 * p01 + a01 * p11
+                v10 = a10 * p00 + a11 * p10
+                v11 = a10 * p01 + a11 * p11
+                W2[i, 0, 0], W2[i, 0, 1], W2[i, 1, 0], W2[i, 1, 1] = v00, v01, v10, v11
+                u00, u01, u10, u11 = U[i - 2, 0, 0], U[i - 2, 0, 1], U[i - 2, 1, 0], U[i - 2, 1, 1]
+                l00 -= v00 * u00 + v01 * u10
+                l01 -= v00 * u01 + v01 * u11
+                l10 -= v10 * u00 + v11 * u10
+                l11 -= v10 * u01 + v11 * u11
+            else:
+                W2[i, 0, 0] = W2[i, 0, 1] = W2[i, 1, 0] = W2[i, 1, 1] = 0.0
             w00 = l00 * q00 + l01 * q10
             w01 = l00 * q01 + l01 * q11
             w10 = l10 * q00 + l11 * q10
@@ -126,13 +148,17 @@ def block_factor(Lb, Db, Ub, w):
 @njit(cache=True)
 def block_substitute(w, r, x):
     """Solve with the factors of :func:`block_factor`: x (n, 2) from r (n, 2); r is kept."""
-    C, W, Ub = w.C, w.W, w.U
+    C, W, Ub, W2 = w.C, w.W, w.U, w.W2
     n = r.shape[0]
     y0 = y1 = 0.0
-    for i in range(n):  # forward: y_i = r_i - W_i y_{i-1}, kept in x
+    for i in range(n):  # forward: y_i = r_i - W_i y_{i-1} - W2_i y_{i-2}, kept in x
         if i > 0:
-            y0, y1 = (r[i, 0] - W[i, 0, 0] * y0 - W[i, 0, 1] * y1,
-                      r[i, 1] - W[i, 1, 0] * y0 - W[i, 1, 1] * y1)
+            z0 = r[i, 0] - W[i, 0, 0] * y0 - W[i, 0, 1] * y1
+            z1 = r[i, 1] - W[i, 1, 0] * y0 - W[i, 1, 1] * y1
+            if i > 1:
+                z0 -= W2[i, 0, 0] * x[i - 2, 0] + W2[i, 0, 1] * x[i - 2, 1]
+                z1 -= W2[i, 1, 0] * x[i - 2, 0] + W2[i, 1, 1] * x[i - 2, 1]
+            y0, y1 = z0, z1
         else:
             y0, y1 = r[0, 0], r[0, 1]
         x[i, 0], x[i, 1] = y0, y1
@@ -150,7 +176,7 @@ def block_substitute(w, r, x):
 @njit(cache=True)
 def factorise(w, mesh):
     """Factorise w's Jacobian blocks; keep the friction slopes they hold (w.sgf)."""
-    for j in range(mesh.j1 + 1, mesh.j2 + 1):
+    for j in range(mesh.c0, mesh.j2 + 1):
         w.sgf[j] = w.sg[j]
     return block_factor(w.Lb, w.Db, w.Ub, w)
 
@@ -159,8 +185,8 @@ def factorise(w, mesh):
 def friction_forces(lam, fnode, t, mesh, p, drive):
     """The nodal friction forces of the friction ratios lam, as :func:`assemble` sets them."""
     fs = p.friction_scale * friction_factor(drive, t)
-    for j in range(mesh.j1 + 1, mesh.j2 + 1):
-        fnode[j] = -mesh.he[j - 1] * fs * lam[j]
+    for j in range(mesh.c0, mesh.j2 + 1):
+        fnode[j] = -mesh.wf[j] * fs * lam[j]
 
 
 @njit(cache=True)
@@ -176,7 +202,7 @@ def release_stuck_ratios(lam, w, mesh, code):
     1 + 2 |rl| per iteration), and Newton goes on.
     """
     stuck = False
-    for j in range(mesh.j1 + 1, mesh.j2 + 1):
+    for j in range(mesh.c0, mesh.j2 + 1):
         if w.sg[j] < NEAR_BOUND and lam[j] * w.rl[j] < 0.0:
             s = w.rl[j] + law_inverse(code, w.lam0[j])[0]
             if abs(law(code, s)[0] - lam[j]) > LAW_GAP:
@@ -229,7 +255,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
             st.merit = merit(R, scales)
             return False
         if p.dual:
-            for j in range(mesh.j1 + 1, mesh.j2 + 1):
+            for j in range(mesh.c0, mesh.j2 + 1):
                 w.lam0[j] = lam[j]
             dlam = update_multipliers(lam, dx, inv_dt, mesh, p, w)
             for i in range(n):
