@@ -28,7 +28,13 @@ from beltsim.physics.model import (
 from beltsim.problem.drive import ramp
 from beltsim.problem.scene import Scene
 from beltsim.solvers import Discretisation
-from beltsim.solvers.newton import NewtonSettings, Workspace, newton
+from beltsim.solvers.newton import (
+    NewtonSettings,
+    Workspace,
+    block_factor,
+    block_substitute,
+    newton,
+)
 from helpers import scene_path
 
 
@@ -118,7 +124,7 @@ def test_jacobian_matches_finite_differences(law_name, inv_dt):
     u, th, old = _random_state(grid, 3, amp=1e-4)
     lam = np.zeros_like(u)
     w, _ = _assemble(d, u, th, lam, old, inv_dt, 1.0, p)
-    J = blocks_to_dense(w.Lb, w.Db, w.Ub)
+    J = blocks_to_dense(w.Lb, w.Db, w.Ub, w.L2)
     n = grid.n_elements - 1
     Jfd = np.zeros_like(J)
     y = np.column_stack([u[1:-1], th[1:-1]]).ravel()
@@ -146,6 +152,22 @@ def test_block_solve_matches_dense():
     x = np.zeros((n, 2))
     assert block_solve(Lb, Db, Ub, r, x, np.zeros((n, 2, 2)))
     ref = np.linalg.solve(blocks_to_dense(Lb, Db, Ub), r.ravel())
+    np.testing.assert_allclose(x.ravel(), ref, rtol=1e-10, atol=1e-12)
+
+
+def test_banded_block_factor_matches_dense():
+    """Newton's block LU with the second lower band (the friction stencil's j - 2)."""
+    rng = np.random.default_rng(5)
+    n = 30
+    w = Workspace.allocate(n + 1)
+    for a in (w.Lb, w.L2, w.Db, w.Ub):
+        a[:] = rng.standard_normal((n, 2, 2))
+    w.Db[:] += 8 * np.eye(2)
+    r = rng.standard_normal((n, 2))
+    x = np.zeros((n, 2))
+    assert block_factor(w.Lb, w.Db, w.Ub, w)
+    block_substitute(w, r, x)
+    ref = np.linalg.solve(blocks_to_dense(w.Lb, w.Db, w.Ub, w.L2), r.ravel())
     np.testing.assert_allclose(x.ravel(), ref, rtol=1e-10, atol=1e-12)
 
 
@@ -190,7 +212,7 @@ def test_dual_newton_solution_satisfies_primal_equations():
     assert np.abs(R[:, 0]).max() < 1e-6 * d.scales.force
     np.testing.assert_allclose(state.fnode, F, atol=1e-9 * d.params.fstar * grid.he.max())
     lam = state.lam
-    sliding = np.abs(lam[grid.j1 + 1:grid.j2 + 1]) > 0.99
+    sliding = np.abs(lam[d.mesh.c0:grid.j2 + 1]) > 0.99
     assert sliding.sum() >= 2 and (~sliding).sum() >= 2
 
 
@@ -198,14 +220,14 @@ def test_update_multipliers_stays_inside_and_follows_linearisation():
     d, grid, p = _setup(N=20, dual=1)
     w = Workspace.allocate(grid.n_elements)
     lam = np.zeros(len(grid.x))
-    lam[grid.j1 + 1:grid.j2 + 1] = 0.5
+    contact = slice(d.mesh.c0, grid.j2 + 1)
+    lam[contact] = 0.5
     rl, sg = w.rl, w.sg
     sg[:] = 0.75
     dx = np.zeros((grid.n_elements - 1, 2))
     # a huge push towards +1: the 99% fraction-to-boundary rule applies
-    rl[grid.j1 + 1:grid.j2 + 1] = 100.0
+    rl[contact] = 100.0
     big = update_multipliers(lam, dx, 0.0, d.mesh, p, w)
-    contact = slice(grid.j1 + 1, grid.j2 + 1)
     np.testing.assert_allclose(lam[contact], 0.5 + 0.99 * 0.5)
     assert big == pytest.approx(0.495)
     # a small push: the linearised update sg * rl

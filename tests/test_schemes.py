@@ -27,7 +27,8 @@ def test_all_schemes_land_on_the_same_discrete_steady_state(slip_by_scheme):
         assert res.converged, res.reason
         assert res.solution.total_friction == pytest.approx(ref.total_friction, rel=1e-5)
         assert np.max(np.abs(res.solution.u - ref.u)) < 1e-5 * scale_u
-        assert res.solution.slip_start == ref.slip_start
+        # read inside the cell: continuous in the state, so equal to the steady tolerance
+        assert res.solution.slip_start == pytest.approx(ref.slip_start, abs=1e-6)
 
 
 @pytest.mark.parametrize("name", ["quasistatic", "inertia", "slip"])
