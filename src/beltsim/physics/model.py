@@ -166,7 +166,7 @@ def model_params(P, damping, friction_scale, v_reg, law_code) -> ModelParams:
 
 # How the transport c d/dx u_b of the slip velocity is discretised (contact_stencil).
 TRANSPORT = "bdf2"
-TRANSPORTS = ("upwind", "bdf2", "central")
+TRANSPORTS = ("upwind", "bdf2", "central", "nodal1")
 
 
 def contact_stencil(x, j1, j2, kind=None):
@@ -180,6 +180,8 @@ def contact_stencil(x, j1, j2, kind=None):
       half volumes at x1 and x2: trapezoidal quadrature). The homogeneous solutions
       of 3-point upwind differences are 1 and (h1/(h1+h2))^2-ish ~ 1/3 per node
       downstream: no odd-even mode;
+    * "nodal1" (measured, first order): the two-point backward difference at node j
+      with the trapezoidal weights of "bdf2";
     * "central" (for the oscillation test): (u_b,{j+1} - u_b,{j-1}) / (x_{j+1} -
       x_{j-1}) with trapezoidal weights; decouples odd and even nodes.
     """
@@ -205,6 +207,8 @@ def contact_stencil(x, j1, j2, kind=None):
             sw[j, 0] = h1 / (h2 * (h1 + h2))
             sw[j, 1] = -(h1 + h2) / (h1 * h2)
             sw[j, 2] = (2.0 * h1 + h2) / (h1 * (h1 + h2))
+        elif kind == "nodal1":
+            sw[j, 1], sw[j, 2] = -1.0 / he[j - 1], 1.0 / he[j - 1]
         else:
             d = he[j - 1] + he[j]
             sw[j, 1], sw[j, 3] = -1.0 / d, 1.0 / d
