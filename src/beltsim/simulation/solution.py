@@ -119,10 +119,10 @@ class DiscreteSolution:
         """(x*, p): the slip start read inside the cell, and the node whose control volume
         holds it (None when no node slides).
 
-        The friction nodes from p + 1 to x2 slide; node p, upstream of them, is
-        partly stuck: its force F_p = f_stick (x* - a) + s f* (b - x*) over the contact
-        part [a, b] of its control volume, f_stick the stick traction extrapolated
-        from the nodes upstream of p, gives x* (clipped to [a, b]).
+        The friction nodes from p + 1 to x2 slide; node p is partly stuck: its force
+        F_p = f_stick (x* - a) + s f* (b - x*) over the contact part [a, b] of its
+        control volume, f_stick the stick traction extrapolated from the nodes
+        upstream of p, gives x* (clipped to [a, b]).
         """
         sl = self._sliding()
         g = self.grid
@@ -133,9 +133,21 @@ class DiscreteSolution:
             j -= 1
         if j == self.c0:
             return float(g.x[g.j1]), None
-        p = j - 1
+        # the partly stuck node is j - 1, or j itself when x* lies at the very start of
+        # its volume (|f_j| >= 0.99 f* already): the one whose x* falls furthest
+        # inside its volume (the other then reads x* at its end)
+        best = None
+        for p in (j - 1, j):
+            xs, depth = self._front_in(p)
+            if best is None or depth > best[2]:
+                best = (xs, p, depth)
+        return best[0], best[1]
+
+    def _front_in(self, p):
+        """x* read from node p's force, clipped to its volume [a, b], and how far
+        inside it lies (min(x* - a, b - x*) / (b - a))."""
         a, b = self._control_volume(p)
-        fslip = np.sign(self.fnode[g.j2]) * self.fs
+        fslip = np.sign(self.fnode[self.grid.j2]) * self.fs
         xs = 0.5 * (a + b)
         for _ in range(3):  # f_stick at the middle of [a, x*]
             fst = self._stick_traction_at(p, 0.5 * (a + xs))
@@ -143,7 +155,7 @@ class DiscreteSolution:
                 break
             xs = (self.fnode[p] - fslip * b + fst * a) / (fst - fslip)
             xs = min(b, max(a, xs))
-        return float(xs), p
+        return float(xs), min(xs - a, b - xs) / (b - a)
 
     @property
     def slip_start(self) -> float:
