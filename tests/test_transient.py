@@ -218,8 +218,11 @@ def test_thin_needs_the_stiffness_held_fixed():
 # grading 1, checks every 2^-11 s, runs to steady state):
 #
 #   implicit  N   250       500       1000      2000      time_tol 1e-4 / 2^(1.5 i)
-#     coulomb     4.352e-3  2.169e-3  1.097e-3  5.502e-4  orders 1.00 0.98 1.00 (fit 0.99)
-#     stick       2.601e-3  1.402e-3  6.959e-4  3.584e-4  orders 0.89 1.01 0.96 (fit 0.96)
+#     coulomb     4.517e-4  2.345e-4  1.207e-4  7.362e-5  orders 0.95 0.96 0.71 (fit 0.88)
+#     stick       4.568e-4  2.570e-4  1.226e-4  7.106e-5  orders 0.83 1.07 0.79 (fit 0.90)
+#   (with the first-order upwind transport in the slip velocity they were 4.352e-3
+#   2.169e-3 1.097e-3 5.502e-4 and 2.601e-3 1.402e-3 6.959e-4 3.584e-4: the second-order
+#   transport leaves the time error and the upwind gyroscopic term, ten times smaller)
 #   pseudo    N   250       500       1000      2000      dt 2^-12 / 2^i
 #     coulomb     5.088e-3  2.562e-3  1.286e-3  6.437e-4  orders 0.99 0.99 1.00 (fit 0.99)
 #     stick       5.860e-3  2.961e-3  1.492e-3  7.494e-4  orders 0.99 0.99 0.99 (fit 0.99)
@@ -231,7 +234,9 @@ def test_thin_needs_the_stiffness_held_fixed():
 # halving below order 0.8 (measured 0.89 at least).
 
 LADDER = [250, 500, 1000, 2000]
-MEASURED_COARSEST = {("implicit", "coulomb"): 4.352e-3, ("implicit", "stick"): 2.601e-3,
+MEASURED_IMPLICIT = {"coulomb": [4.517e-4, 2.345e-4, 1.207e-4, 7.362e-5],
+                     "stick": [4.568e-4, 2.570e-4, 1.226e-4, 7.106e-5]}
+MEASURED_COARSEST = {("implicit", "coulomb"): 4.517e-4, ("implicit", "stick"): 4.568e-4,
                      ("pseudo", "coulomb"): 5.088e-3, ("pseudo", "stick"): 5.860e-3}
 
 
@@ -253,11 +258,16 @@ def test_simulated_history_converges_at_first_order(scheme, kind):
         errors.append(history_error(scene, result))
     errors = np.array(errors)
     bound = 1.25 * MEASURED_COARSEST[scheme, kind] * LADDER[0] / np.array(LADDER)
+    if scheme == "implicit":  # measured ladder (above), 25% margin
+        bound = 1.25 * np.array(MEASURED_IMPLICIT[kind])
     assert np.all(errors <= bound), (errors, bound)
     orders = np.log2(errors[:-1] / errors[1:])
     fitted = -np.polyfit(np.log2(LADDER), np.log2(errors), 1)[0]
-    assert abs(fitted - 1.0) <= 0.1, (fitted, orders)
-    assert np.all(orders >= 0.8), orders
+    if scheme == "pseudo":
+        assert abs(fitted - 1.0) <= 0.1, (fitted, orders)
+        assert np.all(orders >= 0.8), orders
+    else:  # a mix of error sources (time error, upwind gyroscopic term): measured above
+        assert 0.8 <= fitted <= 1.2 and np.all(orders >= 0.65), (fitted, orders)
 
 
 # Time alone, on one grid (250 elements): successive differences of runs whose steps
