@@ -192,27 +192,25 @@ def contact_stencil(x, j1, j2, kind=None):
     wf = np.zeros(N + 1)
     sw = np.zeros((N + 1, 4))
     if kind == "upwind":
-        c0 = j1 + 1
-        for j in range(c0, j2 + 1):
-            wf[j] = he[j - 1]
-            sw[j, 1], sw[j, 2] = -1.0 / he[j - 1], 1.0 / he[j - 1]
-        return c0, wf, sw
+        j = np.arange(j1 + 1, j2 + 1)
+        wf[j] = he[j - 1]
+        sw[j, 1], sw[j, 2] = -1.0 / he[j - 1], 1.0 / he[j - 1]
+        return j1 + 1, wf, sw
     if kind not in TRANSPORTS:
         raise ValueError(f"unknown transport discretisation {kind!r}")
-    c0 = j1
-    for j in range(j1, j2 + 1):
-        wf[j] = 0.5 * ((he[j - 1] if j > j1 else 0.0) + (he[j] if j < j2 else 0.0))
-        if kind == "bdf2":
-            h1, h2 = he[j - 1], he[j - 2]
-            sw[j, 0] = h1 / (h2 * (h1 + h2))
-            sw[j, 1] = -(h1 + h2) / (h1 * h2)
-            sw[j, 2] = (2.0 * h1 + h2) / (h1 * (h1 + h2))
-        elif kind == "nodal1":
-            sw[j, 1], sw[j, 2] = -1.0 / he[j - 1], 1.0 / he[j - 1]
-        else:
-            d = he[j - 1] + he[j]
-            sw[j, 1], sw[j, 3] = -1.0 / d, 1.0 / d
-    return c0, wf, sw
+    j = np.arange(j1, j2 + 1)
+    wf[j] = 0.5 * (np.where(j > j1, he[j - 1], 0.0) + np.where(j < j2, he[j], 0.0))
+    h1, h2 = he[j - 1], he[j - 2]
+    if kind == "bdf2":
+        sw[j, 0] = h1 / (h2 * (h1 + h2))
+        sw[j, 1] = -(h1 + h2) / (h1 * h2)
+        sw[j, 2] = (2.0 * h1 + h2) / (h1 * (h1 + h2))
+    elif kind == "nodal1":
+        sw[j, 1], sw[j, 2] = -1.0 / h1, 1.0 / h1
+    else:
+        d = h1 + he[j]
+        sw[j, 1], sw[j, 3] = -1.0 / d, 1.0 / d
+    return j1, wf, sw
 
 
 def mesh_of(grid, kind=None) -> Mesh:

@@ -107,13 +107,17 @@ class DiscreteSolution:
     def _stick_traction_at(self, p, xq):
         """The stick traction extrapolated to xq from the FIT friction nodes before p
         (quadratic; fewer near x1)."""
-        k = np.arange(max(self.c0, p - FIT), p)
-        f = self.traction
-        if len(k) == 0:
-            return 0.0
-        if len(k) == 1:
-            return float(f[k[0]])
-        return float(np.polyval(np.polyfit(self.grid.x[k], f[k], len(k) - 1), xq))
+        k = range(max(self.c0, p - FIT), p)
+        x = self.grid.x
+        f = {i: self.fnode[i] / self.wf[i] for i in k}
+        value = 0.0  # Lagrange interpolation through the nodes k
+        for i in k:
+            li = 1.0
+            for m in k:
+                if m != i:
+                    li *= (xq - x[m]) / (x[i] - x[m])
+            value += li * f[i]
+        return float(value)
 
     def _slip_front(self):
         """(x*, p): the slip start read inside the cell, and the node whose control volume
