@@ -12,17 +12,23 @@ volumes); the gyroscopic term 2 c u_xt is upwind, 2 rho c hbar_j (v_j - v_{j-1})
 h_{j-1} (the central, skew form leaves a mode that grows at the paper slip steady
 state, +2.5 1/s with the paper's damping: friction in the stick zone pumps the
 rotation; upwind, the slowest mode decays at 10 1/s; both vanish at steady state). The
-transport c d/dx u_b in the slip velocity is upwind: the slip velocity of the
-element [x_{j-1}, x_j] uses the bottom-fibre strain of that element and the
-velocity of its downstream node j, and the element's friction is lumped on node
-j. Treated centrally this term makes the friction alternate in sign from node
-to node in stick zones, and Newton can land on spurious all-slip states. The
+transport c d/dx u_b in the slip velocity is evaluated at the contact nodes x1 .. x2
+with the one-sided three-point (BDF2) derivative over x_{j-2}, x_{j-1}, x_j (second
+order on any grid; upwind, so its parasitic solution decays by ~1/3 per node
+downstream and never alternates), and the friction of node j acts on the contact part
+of its control volume (half volumes at x1 and x2: trapezoidal quadrature). Treated
+centrally (central differences, or element friction lumped half/half) this term makes
+the friction alternate in sign from node to node in stick zones, and Newton can land
+on spurious all-slip states; the two-point upwind form (element [x_{j-1}, x_j] lumped
+on node j, "upwind" in :func:`contact_stencil`) is smooth but first order. The
+stencil reaches node j - 2, so the Jacobian has a second lower block band. The
 damping d acts on local time derivatives only, so it vanishes at steady state
 (damping of the material strain rate would not, and would change the answer).
 
 Time: the residual is written for backward Euler with ``inv_dt`` = 1/dt; with
 ``inv_dt`` = 0 it is the discrete steady problem. Interior nodes 1..N-1 carry
-the unknowns (u_j, theta_j); the Jacobian is block tridiagonal with 2x2 blocks.
+the unknowns (u_j, theta_j); the Jacobian is block banded with 2x2 blocks (two lower
+bands, one upper: the friction stencil's j - 2).
 """
 
 from __future__ import annotations
@@ -177,9 +183,9 @@ def contact_stencil(x, j1, j2, kind=None):
     * "bdf2" (second order): the slip velocity at node j with the one-sided
       three-point derivative over x_{j-2}, x_{j-1}, x_j (exact for quadratics on any
       grid), its friction on the contact part of node j's control volume (c0 = j1,
-      half volumes at x1 and x2: trapezoidal quadrature). The homogeneous solutions
-      of 3-point upwind differences are 1 and (h1/(h1+h2))^2-ish ~ 1/3 per node
-      downstream: no odd-even mode;
+      half volumes at x1 and x2: trapezoidal quadrature). On a uniform grid the
+      homogeneous solutions of the 3-point upwind difference are 1 and 3^-k (k nodes
+      downstream): no odd-even mode;
     * "nodal1" (measured, first order): the two-point backward difference at node j
       with the trapezoidal weights of "bdf2";
     * "central" (for the oscillation test): (u_b,{j+1} - u_b,{j-1}) / (x_{j+1} -
@@ -240,8 +246,8 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
     Friction ratio lam = g(v_rel / v_reg) at each contact node: in the primal
     form (p.dual = 0) it is computed from the trial state; in the primal-dual form
     it is an unknown with the equation rl = v_rel / v_reg - g^{-1}(lam) = 0,
-    condensed node by node into the (u, theta) rows so the Jacobian stays block
-    tridiagonal. w.sg receives the slope dlam/d(v_rel / v_reg) used by
+    condensed node by node into the (u, theta) rows so the Jacobian keeps its
+    block band (two lower block bands from the friction stencil, one upper). w.sg receives the slope dlam/d(v_rel / v_reg) used by
     :func:`update_multipliers`.
     """
     N = u.shape[0] - 1

@@ -170,10 +170,10 @@ class DiscreteSolution:
         """The friction law's dissipation now, -sum F_j v_rel,j over the contact nodes (W).
 
         The numpy twin of the "slip" term of physics.model.power_terms, v_rel read the
-        same way (upwind bottom strain). First order in the element size, with a large
-        constant: v_rel / c = eps_b - e0 is a small difference of the strains (1.2% low
-        on the paper slip scene at 1000 elements); and a perfect-adhesion layer, far
-        thinner than an element, does not show its dissipation here at all.
+        same way (the nodal stencil of physics.model.contact_stencil). v_rel / c =
+        eps_b - e0 is a small difference of the strains, so its relative error is large;
+        and a perfect-adhesion layer, far thinner than an element, does not show its
+        dissipation here at all.
         """
         g, P = self.grid, self.params
         j = np.arange(self.c0, g.j2 + 1)
