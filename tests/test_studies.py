@@ -24,7 +24,7 @@ def test_convergence_command_small_ladder(tmp_path):
         errs = [float(r["error_total_friction"]) for r in table if r["scheme"] == scheme]
         assert errs[0] > errs[1] > errs[2]  # refining shrinks the error
         assert all(float(r["wall_time"]) > 0 for r in table if r["scheme"] == scheme)
-    # extrapolation cancels the leading first-order error: far below the plain solve's
+    # extrapolation cancels the leading second-order error: far below the plain solve's
     for plain, ext in zip([r for r in table if r["scheme"] == "steady"],
                           [r for r in table if r["scheme"] == "richardson"]):
         assert float(ext["error_total_friction"]) < 0.2 * float(plain["error_total_friction"])
@@ -151,11 +151,14 @@ def test_bisected_grid_is_nested():
     np.testing.assert_allclose(f.he[0::2], g.he / 2)
 
 
-def test_richardson_extrapolation_is_second_order_on_the_stick_scene():
-    """Until the regularisation's own error (~2e-6) the extrapolated errors fall at
-    second order: 0.5 -> 0.25 mm elements cut them by ~4 (first order: 2)."""
+def test_richardson_extrapolation_beats_second_order_on_the_stick_scene():
+    """The plain errors are second order, so (4 q(h/2) - q(h)) / 3 leaves a higher order.
+    Below the default adhesion layer's own error (~2e-6) only with a thinner layer:
+    delta = 1e-8 L, 0.5 -> 0.25 mm elements cut them by 11, 11, 7.4 (measured; second
+    order: 4)."""
     errs = [convergence.richardson(load_scene(scene_path("paper_inertia"),
-                                          [f"numerics.elements={n}"]))[2]
+                                          [f"numerics.elements={n}",
+                                           "numerics.adhesion_layer=1e-8"]))[2]
             for n in (125, 250)]
     for key in ("total_friction", "u", "concentrated_force"):
-        assert errs[0][key] / errs[1][key] > 3.0, key
+        assert errs[0][key] / errs[1][key] > 6.0, key

@@ -29,7 +29,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..physics.friction import law_numpy
-from ..physics.model import forces_numpy
+from ..physics.model import forces_numpy, strain_numpy
 from ..problem.drive import Drive, friction_factor, mismatch
 from ..simulation.controller import Simulation
 from ..solvers.newton import ROUNDOFF_FLOOR
@@ -130,21 +130,27 @@ class PeerModel:
         self.static = bmat([[p.tension_eff * second, None, fu_ud, None],
                             [None, ft_th, None, ft_td]], format="coo")
         # friction: node j's force F_j(v_rel) with v_rel = u_t,j + hh theta_t,j
-        # + c (u_b,j - u_b,j-1) / h_{j-1} enters the u row of j and, times hh, its theta row
-        j = np.arange(d.mesh.j1 + 1, d.mesh.j2 + 1)
+        # + c sum_o sw[j, o] u_b,{j-2+o} (physics.model.contact_stencil) enters the u row
+        # of j and, times hh, its theta row
+        m = d.mesh
+        j = np.arange(m.c0, m.j2 + 1)
         self.contact = j
-        hh, c, hl = p.half_height, p.speed, he[j - 1]
+        hh, c = p.half_height, p.speed
         i = j - 1
-        cols = np.stack([i, i - 1, n + i, n + i - 1, 2 * n + i, 3 * n + i])
-        dvrel = np.stack([c / hl, -c / hl, hh * c / hl, -hh * c / hl, np.ones_like(hl),
-                          np.full_like(hl, hh)])
-        keep = cols >= 0  # a contact node next to the boundary node 0 (never in practice)
+        cols, dvrel = [2 * n + i, 3 * n + i], [np.ones(j.size), np.full(j.size, hh)]
+        for o in range(4):
+            k = i - 2 + o  # interior index of node j - 2 + o
+            w = np.where((k >= 0) & (k < n), c * m.sw[j, o], 0.0)
+            cols += [k, n + k]
+            dvrel += [w, hh * w]
+        cols, dvrel = np.stack(cols), np.stack(dvrel)
+        keep = (cols >= 0) & (cols < 4 * n) & (dvrel != 0.0)
         self.fric_cols = np.concatenate([cols[keep], cols[keep]])
         self.fric_rows = np.concatenate([np.broadcast_to(i, cols.shape)[keep],
                                          np.broadcast_to(n + i, cols.shape)[keep]])
         self._fnode = np.concatenate([np.broadcast_to(np.arange(j.size), cols.shape)[keep]] * 2)
         self._fcoef = np.concatenate([dvrel[keep], hh * dvrel[keep]])
-        self._hl = hl
+        self._wf = m.wf[j]
 
     def unpack(self, y):
         """Full nodal arrays (boundary zeros) of the interior values in y; rates absent
@@ -167,12 +173,12 @@ class PeerModel:
         d = self.disc
         p, drive = p or d.model, drive or d.drive
         u, th, ud, td = self.unpack(y)
-        j, hh, c, hl = self.contact, p.half_height, p.speed, self._hl
+        j, hh, c = self.contact, p.half_height, p.speed
         ub = u + hh * th
-        vrel = ud[j] + hh * td[j] + c * (ub[j] - ub[j - 1]) / hl - mismatch(drive, t)
+        vrel = ud[j] + hh * td[j] + c * strain_numpy(ub, d.mesh.sw, j) - mismatch(drive, t)
         fs = p.friction_scale * friction_factor(drive, t)
         slope = law_numpy(p.law, vrel / p.v_reg)[1]
-        k = hl * fs * slope / p.v_reg  # -dF_j/dv_rel
+        k = self._wf * fs * slope / p.v_reg  # -dF_j/dv_rel
         return -k[self._fnode] * self._fcoef
 
     def force_jacobian(self, t, y, drive=None, p=None):
