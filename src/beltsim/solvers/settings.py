@@ -3,8 +3,9 @@
 Defaults (all overridable in [numerics]):
 
 * ``elements`` max(1000, 16 L max(alpha, beta)): 1000, or more where theta decays
-  over a shorter length than the paper's 17 mm; ``grading`` 8 (smallest element at
-  x2, largest 8x bigger);
+  over a shorter length than the paper's 17 mm; ``grading`` 8 (smallest elements at
+  x2 and at the analytic slip start, where friction jumps to f*: x1 when the whole
+  contact slides; largest 8x bigger);
 * ``ramp_time`` 2 L / c: the surface speed goes smoothly from c to v (a number or a
   sine; a table sets its own times, :mod:`beltsim.problem.drive`);
 * ``dt`` max(ramp_time, L / c) / 50;
@@ -47,6 +48,7 @@ from dataclasses import dataclass
 from ..errors import SceneError
 from ..physics.friction import LAW_CODES
 from ..physics.grid import Grid, make_grid
+from ..problem import analytic
 from ..problem.analytic import decay_rates
 from ..problem.drive import largest_mismatch, period_of, profile_times, speed_ramped
 from ..problem.scene import Params, Scene
@@ -190,4 +192,19 @@ def default_elements(P: Params) -> int:
 
 def build_grid(scene: Scene, num: Numerics) -> Grid:
     P = scene.params
-    return make_grid(P.L, P.x1, P.x2, num.elements, num.grading)
+    return make_grid(P.L, P.x1, P.x2, num.elements, num.grading,
+                     refine_at=expected_slip_start(scene))
+
+
+def expected_slip_start(scene: Scene) -> tuple:
+    """Where the friction jumps to f* at steady state (x1 when the whole contact
+    slides), from the analytic solution: the grid is graded towards it as towards x2.
+    Empty for stick scenes, periodic drives and scenes without an analytic solution."""
+    P = scene.params
+    if P.friction != "coulomb" or period_of(scene) is not None:
+        return ()
+    try:
+        x_star = analytic.solve(scene).x_star
+    except analytic.NoSolutionError:
+        return ()
+    return () if x_star is None or x_star >= P.x2 else (float(x_star),)
