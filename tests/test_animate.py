@@ -12,7 +12,7 @@ from helpers import cli, scene_path
 def test_animate_runs_and_stores_a_gif_then_mp4_from_the_stored_run(tmp_path):
     run_dir = tmp_path / "run"
     proc = cli("animate", scene_path("paper_slip"), "--set", "numerics.elements=150",
-                "--interval", "0.01", "--fps", "5", "--out", str(run_dir), "--quiet")
+                "--interval", "0.05", "--fps", "5", "--out", str(run_dir), "--quiet")
     assert proc.returncode == 0, proc.stderr
     gif = Image.open(run_dir / "transient.gif")
     assert gif.n_frames > 5

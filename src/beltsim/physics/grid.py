@@ -2,8 +2,9 @@
 
 Nodes sit exactly at x1 and x2, so the contact zone is a union of whole
 elements. Elements can be graded towards x2, where the concentrated force and
-the steepest gradients are: the element size grows linearly with the distance
-from x2, up to ``grading`` times the smallest element.
+the steepest gradients are, and towards further points (the expected slip start,
+where friction jumps to f*): the element size grows linearly with the distance
+from the nearest of them, up to ``grading`` times the smallest element.
 """
 
 from __future__ import annotations

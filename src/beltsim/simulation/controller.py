@@ -172,7 +172,8 @@ class Simulation:
         status, reason = RunStatus.REACHED_END, None
         start = time.perf_counter()
         try:
-            while self.t < t_end:
+            # a fixed-step scheme's t carries round-off: within 1e-9 of a check is there
+            while self.t < t_end - 1e-9 * self.check:
                 good = (self.state.copy(), self.t, self.scheme.checkpoint())
                 try:
                     # checks on a fixed grid k * check: a scheme that steps past a

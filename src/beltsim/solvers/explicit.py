@@ -319,8 +319,11 @@ def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, driv
                 yv[j] = 1.5 * ud[j] - 0.5 * va[j]
                 yw[j] = 1.5 * td[j] - 0.5 * wa[j]
     steps = 0
-    while t < t_stop and steps < max_steps:
-        last = t + dt >= t_stop or steps + 1 >= max_steps
+    # t accumulates round-off: a stop within 1e-9 dt counts as reached, or a run of
+    # t_stop / dt steps could take one more
+    t_reached = t_stop - 1e-9 * dt
+    while t < t_reached and steps < max_steps:
+        last = t + dt >= t_reached or steps + 1 >= max_steps
         # the velocity terms with the drift (the system is lower bidiagonal: one pass in
         # the direction of the flow), and the kick of node j - 1 once its neighbours
         # have drifted; node N passes through with zero coefficients, so the loop needs

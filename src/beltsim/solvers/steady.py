@@ -2,8 +2,12 @@
 
 The surface speed goes from c to v in stages of continuation (the mismatch
 v - c scaled by s in (0, 1]): a stage that converges doubles the next one, a
-failed stage is undone and retried with a quarter of its size. It lands on the
-same discrete steady state as the transient schemes.
+failed stage is undone and retried with a quarter of its size. A saturating friction
+law is first solved with a regularisation velocity REGULARISATION_START times the
+scene's (smooth friction, few iterations) and then with the scene's from there: on
+the paper slip scene (1000 elements) 38 Newton iterations instead of 96 from rest
+(1e2: 47, 1e4: 46, the ladder 1e4, 1e3, 1e2, 10, 1: 43). It lands on the same
+discrete steady state as the transient schemes.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from .registry import register
 
 MIN_STAGE = 1e-6  # smallest continuation stage, relative to the full mismatch
 STAGE_ITERATIONS = 4  # Newton iterations per stage, in units of newton_max_iterations
+REGULARISATION_START = 1e3  # v_reg of the first solve of a saturating law, in units of the scene's
 
 
 @register
@@ -37,10 +42,21 @@ class SteadyScheme(NewtonScheme):
         self.work.stats[:] = 0
 
     def solve(self, state) -> None:
-        """Continuation in v - c; the number of stages is counted as steps.
+        """Continuation in v - c (after one in v_reg for a saturating law); the number of
+        stages is counted as steps.
 
         Raises NumericalError when the stage falls below MIN_STAGE of the mismatch.
         """
+        model = self.disc.model
+        if model.dual:
+            self.disc.model = model._replace(v_reg=REGULARISATION_START * model.v_reg)
+            try:
+                self._continue_in_speed(state)
+            finally:
+                self.disc.model = model
+        self._continue_in_speed(state)
+
+    def _continue_in_speed(self, state) -> None:
         stage_settings = self.settings._replace(
             max_iterations=STAGE_ITERATIONS * self.settings.max_iterations)
         s_done, ds = 0.0, 1.0
