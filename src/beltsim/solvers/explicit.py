@@ -33,23 +33,31 @@ one mode still grows at +0.28/s, which a run reproduces (within 5% of the steady
 friction up to t_end). The central term, by a tridiagonal (Thomas) solve, was also
 stable by von Neumann but grew near its limit on bounded grids without damping.
 
-Friction is implicit in each contact node's own velocity. Its slope f* / v_reg is
+Friction is implicit in each friction node's own velocity. Its slope f* / v_reg is
 enormous, so the velocity it sees must damp the friction relaxation (the mean of the
 velocities before and after the kick, trapezoidal, rings with amplification -1 and,
 with the transport term, diverges in stick) yet be second order (the velocity after
-the kick, backward Euler, is first order). The slip velocity of node j is taken as
+the kick, backward Euler, is first order). The slip velocity of node j (c0 .. j2, the
+model's friction nodes, physics.model.contact_stencil) is taken as
 
     b_before + A_EST delta_j - C_EST delta_j^{n-1}
-    + (c / h) [(ub_j + ALPHA dt delta_j) - (ub_{j-1} + ALPHA dt delta_{j-1})] - (v - c)
+    + c sum_k sw[j, k] (ub_k + ALPHA dt delta_k) - (v - c),   k = j-2, j-1, j
 
 with b = u_t + (h/2) theta_t the bottom-fibre velocity, delta its kick increment (this
-step's, and the previous step's for C_EST) and A_EST - C_EST = 1/2 (consistency). The
+step's, and the previous step's for C_EST), sw the model's one-sided three-point
+(second-order) transport stencil, and A_EST - C_EST = 1/2 (consistency); the node's
+friction force is wf_j f* g, wf_j the contact part of its control volume. The
 corrections are dt times changes of increments: O(dt^2) where friction is smooth,
 zero at steady state. C_EST = 1/16 puts the roots of the stiff limit at -1/3 (a
 double root, the smallest reachable); ALPHA makes the stick-zone transport (upwind,
-explicit in u_n) stable at any Courant number c dt / h (without it the stiff limit
-needs c dt / h < 0.25, below the waves' limit). delta_{j-1} is known first in a
-sweep in the direction of the flow, so each node is one monotone scalar equation.
+explicit in u_n) stable at large Courant numbers r = c dt / h: in the stiff limit of
+the bottom fibre alone (no waves, no gyroscopic term) the three-point transport needs
+r < 0.25 without it, r < 1.9 with ALPHA = 0.3 and r < 2.0 with ALPHA >= 0.5 (the
+two-point upwind transport of the first-order model was stable at any r with ALPHA =
+0.25; the three-point symbol is twice as large at kh = pi). The waves' limit keeps
+r = c / sqrt(B / rho) below 1 on the paper's data. delta_{j-1} and delta_{j-2} are
+known first in a sweep in the direction of the flow, so each node is one monotone
+scalar equation.
 
 The step is EXPLICIT_SAFETY of the limit found by a von Neumann analysis of this
 scheme (both fields, friction at all slopes with its transport) on the smallest
@@ -69,7 +77,7 @@ from numba import njit
 
 from ..errors import SceneError
 from ..physics.friction import LINEAR, RAMP, SQRT, TANH, law
-from ..physics.model import hermite_weights, load_at
+from ..physics.model import contact_stencil, hermite_weights, load_at
 from ..problem.drive import friction_factor, mismatch
 from .base import Scheme
 from .registry import register
@@ -82,7 +90,7 @@ SAFE_FASTMATH = {"reassoc", "contract", "arcp"}
 # friction's velocity estimate (module notes): consistency needs A_EST - C_EST = 1/2
 C_EST = 1.0 / 16.0
 A_EST = 0.5 + C_EST
-ALPHA = 0.25
+ALPHA = 0.5
 # friction slopes of the von Neumann analysis, as dt k (1/rho + (h/2)^2 / I): the
 # relaxation of the bottom-fibre velocity per step, from none (sliding) to stick
 FRICTION_Z = np.concatenate([[0.0], np.logspace(-3.0, 9.0, 17)])
@@ -162,9 +170,13 @@ class Coefficients(NamedTuple):
     fm: np.ndarray  # contact nodes: dt / m_j, dt (h/2) / m_I,j: a nodal force's kick
     fi: np.ndarray
     kb: np.ndarray  # fm + (h/2) fi: the bottom-fibre kick of a unit force
-    ch: np.ndarray  # c / h_{j-1}
-    tr: np.ndarray  # ALPHA c dt / h_{j-1}
-    fh: np.ndarray  # h_{j-1} f_s
+    t0: np.ndarray  # friction nodes: c sw[j, 0..2], the transport c d/dx u_b at node j
+    t1: np.ndarray  # from u_b at j-2, j-1, j (mesh.sw, physics.model.contact_stencil)
+    t2: np.ndarray
+    a0: np.ndarray  # ALPHA dt t0, ALPHA dt t1: the transport of the increments at j-2, j-1
+    a1: np.ndarray
+    tr: np.ndarray  # ALPHA dt t2: the same at node j itself
+    fh: np.ndarray  # wf_j f_s: the node's friction weight times the friction scale
     kap: np.ndarray  # (A_EST + tr) kb fh / v_reg: the scalar friction equation's kappa
 
 
@@ -172,11 +184,12 @@ class Coefficients(NamedTuple):
 def coefficients(dt, mesh, p):
     """The Coefficients of steps of size dt (once per advance, O(N))."""
     N = mesh.he.shape[0]
-    he, hb = mesh.he, mesh.hb
+    he, hb, sw, wf = mesh.he, mesh.hb, mesh.sw, mesh.wf
     rho, rot, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
     z = np.zeros
     co = Coefficients(z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1),
-                      z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1))
+                      z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1),
+                      z(N + 1), z(N + 1), z(N + 1))
     for j in range(1, N):
         m, mi = rho * hb[j], rot * hb[j]
         # row j of (2/dt + d + G) vm = (2/dt) v_a over the lumped mass, with
@@ -192,30 +205,37 @@ def coefficients(dt, mesh, p):
         co.fm[j] = dt / m
         co.fi[j] = dt * hh / mi
         co.kb[j] = co.fm[j] + hh * co.fi[j]
-        co.ch[j] = c / he[j - 1]
-        co.tr[j] = ALPHA * c * dt / he[j - 1]
-        co.fh[j] = he[j - 1] * p.friction_scale
+    for j in range(mesh.c0, mesh.j2 + 1):
+        co.t0[j], co.t1[j], co.t2[j] = c * sw[j, 0], c * sw[j, 1], c * sw[j, 2]
+        co.a0[j], co.a1[j] = ALPHA * dt * co.t0[j], ALPHA * dt * co.t1[j]
+        co.tr[j] = ALPHA * dt * co.t2[j]
+        co.fh[j] = wf[j] * p.friction_scale
         co.kap[j] = (A_EST + co.tr[j]) * co.kb[j] * co.fh[j] / p.v_reg
     return co
 
 
 @njit(cache=True, fastmath=SAFE_FASTMATH)
 def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, ff, co, mesh, p):
-    """The kick's friction at the contact nodes, in the direction of the flow.
+    """The kick's friction at the friction nodes c0..j2, in the direction of the flow.
 
     On entry va, wa hold the kick without friction, bb the bottom-fibre velocity
     before the kick and eb its increment without friction; db the previous kick's
-    bottom increments, replaced by this kick's. ff: f*(t) / f* of the drive.
+    bottom increments, replaced by this kick's. ff: f*(t) / f* of the drive. The
+    transport reaches nodes j-2 and j-1 (mesh.sw): their increments of this kick are
+    known when node j is solved (upstream of c0, the kick without friction).
     """
-    j1, j2, hh, code, ivreg = mesh.j1, mesh.j2, p.half_height, p.law, 1.0 / p.v_reg
+    c0, j2, hh, code, ivreg = mesh.c0, mesh.j2, p.half_height, p.law, 1.0 / p.v_reg
     smooth = code == TANH or code == SQRT
-    ub_l = u[j1] + hh * th[j1]
-    db_l = eb[j1]  # x1's node has no friction
-    for j in range(j1 + 1, j2 + 1):
+    ub_l2 = u[c0 - 2] + hh * th[c0 - 2]
+    ub_l1 = u[c0 - 1] + hh * th[c0 - 1]
+    d_l2 = eb[c0 - 2]  # nodes upstream of the friction nodes carry no friction
+    d_l1 = eb[c0 - 1]
+    for j in range(c0, j2 + 1):
         ub = u[j] + hh * th[j]
         tr = co.tr[j]
-        known = (bb[j] + (A_EST + tr) * eb[j] - C_EST * db[j] + co.ch[j] * (ub - ub_l)
-                 - tr * db_l - target)
+        known = (bb[j] + (A_EST + tr) * eb[j] - C_EST * db[j]
+                 + co.t0[j] * ub_l2 + co.t1[j] * ub_l1 + co.t2[j] * ub
+                 + co.a0[j] * d_l2 + co.a1[j] * d_l1 - target)
         # the first Newton iteration of _friction_scalar, written out and evaluated
         # at the warm start s0 before the slip velocity is known: the sweep's chain
         # from node to node is then a few multiplications, while the law's exp and
@@ -246,8 +266,8 @@ def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, ff, co, mesh, 
         wa[j] += co.fi[j] * F
         d = eb[j] + co.kb[j] * F
         db[j] = d
-        db_l = d
-        ub_l = ub
+        d_l2, d_l1 = d_l1, d
+        ub_l2, ub_l1 = ub_l1, ub
         sfr[j] = s
         fnode[j] = F
 
@@ -373,6 +393,14 @@ def _gyro_symbol(c, h, kh):
     return 2.0 * c * (1.0 - np.exp(-1j * kh)) / h
 
 
+def _transport_symbol(c, h, kh):
+    """c d/dx of the slip velocity on a uniform grid (1/s), for the mode e^{i kh j}: the
+    model's stencil (physics.model.contact_stencil) read at an inner contact node of a
+    uniform grid; (3 - 4 e^{-i kh} + e^{-2 i kh}) / (2 h) for the three-point "bdf2"."""
+    _, _, sw = contact_stencil(h * np.arange(8.0), 2, 6)
+    return c * sum(sw[4, o] * np.exp(1j * kh * (o - 2)) for o in range(4))
+
+
 def _amplification_matrices(params, h, dt, damping, kh, z):
     """Amplification matrices (..., 5, 5) of one step on a uniform grid of elements h.
 
@@ -385,7 +413,7 @@ def _amplification_matrices(params, h, dt, damping, kh, z):
     kh, z = np.broadcast_arrays(np.asarray(kh, float), np.asarray(z, float))
     trap = (2.0 / dt) / (2.0 / dt + damping + _gyro_symbol(c, h, kh))  # vm = trap v_a
     lap = -(2.0 - 2.0 * np.cos(kh)) / h**2
-    up = c * dt * (1.0 - np.exp(-1j * kh)) / h  # c dt D_upwind (the slip velocity's)
+    up = dt * _transport_symbol(c, h, kh)  # c dt D (the slip velocity's transport)
     kb = 1.0 / rho + hh * hh / rot
     a = A_EST + ALPHA * up
     cols = []
@@ -499,6 +527,10 @@ class ExplicitScheme(Scheme):
     def __init__(self, disc):
         super().__init__(disc)
         P, num, grid = disc.params, self.numerics, disc.grid
+        if np.any(disc.mesh.sw[:, 3] != 0.0):
+            # a stencil reaching downstream (j + 1) is not known in the sweep along the flow
+            raise SceneError("numerics.integrator: the explicit scheme needs an upwind "
+                             "transport stencil in the slip velocity")
         limit = explicit_stable_dt(P, grid.h_min, disc.model.damping)
         if not limit > 0.0:
             raise SceneError("numerics.integrator: the explicit scheme has no stable step "
