@@ -52,9 +52,11 @@ zero at steady state. C_EST = 1/16 puts the roots of the stiff limit at -1/3 (a
 double root, the smallest reachable); ALPHA makes the stick-zone transport (upwind,
 explicit in u_n) stable at large Courant numbers r = c dt / h: in the stiff limit of
 the bottom fibre alone (no waves, no gyroscopic term) the three-point transport needs
-r < 0.25 without it, r < 1.9 with ALPHA = 0.3 and r < 2.0 with ALPHA >= 0.5 (the
-two-point upwind transport of the first-order model was stable at any r with ALPHA =
-0.25; the three-point symbol is twice as large at kh = pi). The waves' limit keeps
+r < 0.13 without it, r < 1.5 with ALPHA = 0.25, r < 1.9 with 0.3 and r < 2.0 with
+ALPHA >= 0.5 (the two-point upwind transport of the first-order model: r < 0.26
+without it, any r with ALPHA = 0.25; the three-point symbol is twice as large at
+kh = pi). The full von Neumann analysis below (with the gyroscopic and wave terms)
+decides the step of each scene. The waves' limit keeps
 r = c / sqrt(B / rho) below 1 on the paper's data. delta_{j-1} and delta_{j-2} are
 known first in a sweep in the direction of the flow, so each node is one monotone
 scalar equation.
