@@ -84,15 +84,22 @@ def test_explicit_and_implicit_histories_agree(ladder, damping, measured):
 def test_power_balance_closes_at_the_time_error(ladder):
     """E(t) - E(0) against the integrated power terms, relative to the dissipated energy.
 
-    Measured: 2.4e-6, 2.3e-7, 5.2e-8, 1.1e-8 for time_tol 1e-4 ... 1e-7: the residual is
-    the time integration's, and falls with it. Friction dissipates almost all (slip
-    4.4e3 J against damping 0.4 J on the default grid), so the balance tests the
-    friction's power split, not only the damping.
+    Measured with the second-order transport: 2.8e-6, 8.1e-8, 7.2e-9, 1.0e-8 for
+    time_tol 1e-4 ... 1e-7: the residual is the time integration's, and falls with it,
+    but not monotonically: it is the sum of time errors of opposite signs, and its sign
+    changes near time_tol 1e-6 (signed, J: -4.1e-3, -1.2e-4, -5.7e-5, +1.0e-5, +2.4e-5,
+    +1.5e-5, +6.5e-6, +2.9e-6 at 1e-4, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 3e-8, 1e-8; newton_tol
+    1e-12 changes the 1e-7 run's by 1%), so the 1e-6 run sits below the 1e-7 one. (With
+    the first-order transport: 2.4e-6, 2.3e-7, 5.2e-8, 1.1e-8.) Bounds: the loosest
+    measurement + 75%, each decade below the first, and the tightest run + 50%. Friction
+    dissipates almost all (slip 4.4e3 J against damping 0.4 J on the default grid), so
+    the balance tests the friction's power split, not only the damping.
     """
     residuals = [ladder[tol].power_balance["relative_residual"]
                  for tol in (1e-4, 1e-5, 1e-6, 1e-7)]
     assert residuals[0] < 5e-6
-    assert all(a > b for a, b in zip(residuals, residuals[1:])), residuals
+    assert residuals[0] > residuals[1] > max(residuals[2:]), residuals
+    assert residuals[3] < 1.5e-8, residuals
     pb = ladder[1e-4].power_balance
     assert pb["slip_dissipation"] > 0 and pb["damping_dissipation"] > 0
     assert pb["load_work"] == 0.0
