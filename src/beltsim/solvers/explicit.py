@@ -221,23 +221,24 @@ def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, ff, co, mesh, 
     """The kick's friction at the friction nodes c0..j2, in the direction of the flow.
 
     On entry va, wa hold the kick without friction, bb the bottom-fibre velocity
-    before the kick and eb its increment without friction; db the previous kick's
-    bottom increments, replaced by this kick's. ff: f*(t) / f* of the drive. The
+    before the kick (overwritten) and eb its increment without friction; db the
+    previous kick's bottom increments, replaced by this kick's. ff: f*(t) / f* of the drive. The
     transport reaches nodes j-2 and j-1 (mesh.sw): their increments of this kick are
     known when node j is solved (upstream of c0, the kick without friction).
     """
     c0, j2, hh, code, ivreg = mesh.c0, mesh.j2, p.half_height, p.law, 1.0 / p.v_reg
     smooth = code == TANH or code == SQRT
-    ub_l2 = u[c0 - 2] + hh * th[c0 - 2]
-    ub_l1 = u[c0 - 1] + hh * th[c0 - 1]
+    # the slip velocity's estimate but for this kick's friction, into bb (one pass
+    # without a chain from node to node)
+    for j in range(c0, j2 + 1):
+        bb[j] += ((A_EST + co.tr[j]) * eb[j] - C_EST * db[j]
+                  + co.t0[j] * (u[j - 2] + hh * th[j - 2])
+                  + co.t1[j] * (u[j - 1] + hh * th[j - 1])
+                  + co.t2[j] * (u[j] + hh * th[j]) - target)
     d_l2 = eb[c0 - 2]  # nodes upstream of the friction nodes carry no friction
     d_l1 = eb[c0 - 1]
     for j in range(c0, j2 + 1):
-        ub = u[j] + hh * th[j]
-        tr = co.tr[j]
-        known = (bb[j] + (A_EST + tr) * eb[j] - C_EST * db[j]
-                 + co.t0[j] * ub_l2 + co.t1[j] * ub_l1 + co.t2[j] * ub
-                 + co.a0[j] * d_l2 + co.a1[j] * d_l1 - target)
+        known = bb[j] + co.a0[j] * d_l2 + co.a1[j] * d_l1
         # the first Newton iteration of _friction_scalar, written out and evaluated
         # at the warm start s0 before the slip velocity is known: the sweep's chain
         # from node to node is then a few multiplications, while the law's exp and
@@ -269,7 +270,6 @@ def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, ff, co, mesh, 
         d = eb[j] + co.kb[j] * F
         db[j] = d
         d_l2, d_l1 = d_l1, d
-        ub_l2, ub_l1 = ub_l1, ub
         sfr[j] = s
         fnode[j] = F
 
