@@ -5,7 +5,6 @@ import math
 import tomllib
 
 import numpy as np
-from helpers import cli
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -15,6 +14,7 @@ from beltsim.problem.scene import Scene, load_scene, runs_dir
 from beltsim.solvers.settings import resolve
 from beltsim.studies import random_scenes as rs
 from beltsim.studies.stability import ACCEPTED, CellStatus
+from helpers import cli
 
 
 @settings(max_examples=300, deadline=None)

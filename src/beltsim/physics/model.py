@@ -247,15 +247,15 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
     form (p.dual = 0) it is computed from the trial state; in the primal-dual form
     it is an unknown with the equation rl = v_rel / v_reg - g^{-1}(lam) = 0,
     condensed node by node into the (u, theta) rows so the Jacobian keeps its
-    block band (two lower block bands from the friction stencil, one upper). w.sg receives the slope dlam/d(v_rel / v_reg) used by
-    :func:`update_multipliers`.
+    block band (two lower block bands from the friction stencil, one upper). w.sg
+    receives the slope dlam/d(v_rel / v_reg) used by :func:`update_multipliers`.
     """
     N = u.shape[0] - 1
     B, A, b2 = p.tension_eff, p.bending_eff, p.shear
     rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
     damp, vreg = p.damping, p.v_reg
     fs = p.friction_scale * friction_factor(drive, t)
-    he, hb, j1, j2 = mesh.he, mesh.hb, mesh.j1, mesh.j2
+    he, hb, j2 = mesh.he, mesh.hb, mesh.j2
     c0, wf, sw = mesh.c0, mesh.wf, mesh.sw
     uo, tho, udo, tdo = old.u, old.theta, old.ud, old.td
     R, Lb, Db, Ub, rl, sg = w.R, w.Lb, w.Db, w.Ub, w.rl, w.sg

@@ -18,8 +18,8 @@ from ..io.files import OutputError, atomic_path
 from ..io.results import read_snapshots
 from ..problem import analytic
 from ..problem.drive import drive_of, friction_factor, has_profiles, mismatch
-from ..solvers.settings import resolve
 from ..simulation.solution import stress_resultants
+from ..solvers.settings import resolve
 from .common import pyplot
 
 MAX_FRAMES = 150

@@ -27,7 +27,6 @@ from ..physics.model import contact_stencil, strain_numpy, traction
 from ..problem.analytic import AnalyticSolution
 from ..problem.scene import Params
 
-
 LAYER, FIT = 3, 3  # nodes of the discrete force layer at x2, and of the smooth fit
 
 
