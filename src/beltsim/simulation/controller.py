@@ -121,7 +121,8 @@ class Simulation:
         mismatch = mismatch_at(self.disc.drive, self.t) if self.scheme.transient else None
         return DiscreteSolution(self.params, self.grid, self.state.u, self.state.theta,
                                 self.state.fnode, n.law_code, n.fs, self.state.ud,
-                                self.state.td, mismatch)
+                                self.state.td, mismatch,
+                                (self.disc.mesh.c0, self.disc.mesh.wf, self.disc.mesh.sw))
 
     # stepping ---------------------------------------------------------
     def warm_up(self) -> float:

@@ -52,7 +52,7 @@ def relative_error(value, exact) -> float:
 
 class DiscreteSolution:
     def __init__(self, params: Params, grid: Grid, u, theta, fnode, law_code, fs, ud=None,
-                 td=None, mismatch=None):
+                 td=None, mismatch=None, stencil=None):
         self.params = params
         self.grid = grid
         self.u = np.asarray(u, dtype=float).copy()
@@ -66,8 +66,10 @@ class DiscreteSolution:
         self.fs = fs
         # v(t) - c at the state's time (the drive's final value by default)
         self.mismatch = params.v - params.c if mismatch is None else float(mismatch)
-        # the friction nodes, their weights and slip-velocity stencils (physics.model)
-        self.c0, self.wf, self.sw = contact_stencil(grid.x, grid.j1, grid.j2)
+        # the friction nodes, their weights and slip-velocity stencils (physics.model;
+        # a run passes its mesh's rather than rebuild them at every check)
+        self.c0, self.wf, self.sw = (contact_stencil(grid.x, grid.j1, grid.j2)
+                                     if stencil is None else stencil)
 
     @property
     def x(self):
