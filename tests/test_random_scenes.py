@@ -167,3 +167,17 @@ def test_the_deferred_schemes_get_their_share_of_max_wall(monkeypatch):
     assert first and deferred and max(deferred) <= max(first) < 39
     assert all(r["reason"].startswith("--max-wall 2 s") for r in rows
                if r["status"] == rs.SKIPPED)
+
+
+def test_an_undamped_scene_still_ringing_at_t_end_counts_as_bounded():
+    """Undamped, only friction dissipates and a time-accurate run may ring past t_end: it
+    says so (not steady) and the study counts it like the matrix's span cases; a damped
+    scene that has not settled stays a failure."""
+    scene = load_scene(runs_dir() / "paper_slip.toml", ["numerics.elements=120"])
+    short = ("numerics.t_end=0.02",)
+    undamped = rs.random_cell(scene.with_overrides(["physics.damping=0"]), 0, "implicit",
+                              extra=short)
+    assert undamped["status"] == CellStatus.BOUNDED.value, undamped
+    assert undamped["reason"].startswith("undamped, still ringing: not steady by t_end")
+    damped = rs.random_cell(scene, 1, "implicit", extra=short)
+    assert damped["status"] == CellStatus.NOT_CONVERGED.value and rs.failed(damped), damped
