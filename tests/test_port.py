@@ -14,9 +14,9 @@ from beltsim.studies import port
 from helpers import scene_path
 
 
-def _runs(overrides):
+def _runs(overrides, solver="splu"):
     scene = load_scene(scene_path("paper_slip"), overrides)
-    return Simulation(scene).run(), port.port_simulation(scene).run()
+    return Simulation(scene).run(), port.port_simulation(scene, solver=solver).run()
 
 
 def test_port_takes_the_implicit_schemes_steps():
@@ -35,6 +35,14 @@ def test_port_takes_the_implicit_schemes_steps():
     for key, value in ours.power_balance.items():
         if isinstance(value, float):
             assert theirs.power_balance[key] == pytest.approx(value, rel=1e-6, abs=1e-9), key
+
+
+def test_banded_port_takes_the_same_steps():
+    ours, theirs = _runs(["numerics.elements=40", "numerics.t_end=0.03"], solver="banded")
+    np.testing.assert_array_equal(ours.history["t"], theirs.history["t"])
+    assert theirs.statistics["steps"] == ours.statistics["steps"]
+    a, b = ours.solution.total_friction, theirs.solution.total_friction
+    assert abs(a - b) <= 1e-8 * abs(a)
 
 
 def test_port_refuses_what_it_does_not_implement():
