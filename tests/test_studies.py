@@ -91,6 +91,11 @@ def test_bench_command_prints_json_last(tmp_path):
     # same grid, same discretisation, same steady criterion: the same steady state
     assert abs(last["ours_error"] - last["peer_error"]) < 1e-4
     assert last["explicit_node_steps_per_s"] > 0
+    # the port of the default scheme: same steps, same state, its ratio reported
+    row = last["port"]
+    assert row["converged"] is True and row["steps"] == row["ours_steps"]
+    assert row["total_friction_vs_ours"] < 1e-8
+    assert last["kernel_speedup"] == row["wall_time"] / last["ours_wall_time"]
 
 
 def test_bench_refuses_a_bad_repeat_count(capsys):

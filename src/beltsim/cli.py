@@ -172,7 +172,8 @@ def cmd_bench(args):
 
     result = studies.bench(args.scene, args.overrides, peer=not args.no_peer,
                            cold=not args.no_cold, elements=args.elements, repeat=args.repeat,
-                           peer_cap=args.peer_cap, search=args.search_rtol)
+                           peer_cap=args.peer_cap, search=args.search_rtol,
+                           port=not args.no_port)
     print(studies.bench_json(result))
     return 0
 
@@ -483,6 +484,8 @@ def build_parser():
                    help="first find each transient peer's loosest rtol on this grid")
     p.add_argument("--no-peer", action="store_true", help="skip the peers")
     p.add_argument("--no-cold", action="store_true", help="skip the cold-start run")
+    p.add_argument("--no-port", action="store_true",
+                   help="skip the numpy/scipy.sparse port of the default scheme")
     p.set_defaults(func=cmd_bench)
     return parser
 

@@ -133,8 +133,46 @@ def run_peers(scene: Scene, exact: float, reference: float, repeat: int = 3,
     return out
 
 
+def run_port_entry(scene: Scene, ours, exact: float, repeat: int = 3, log=print) -> dict:
+    """The port of the default scheme (:mod:`beltsim.studies.port`) on ``scene``, against
+    ``ours`` (beltsim's RunResult of the same scene): the ``port`` dict of :func:`bench`.
+
+    Converged: steady by the run's test on beltsim's steady state (SAME_STATE); the
+    port takes the same steps, so its step count and total friction are reported beside
+    ours (``total_friction_vs_ours``: relative difference).
+    """
+    from . import port as portlib
+
+    description = "beltsim's implicit scheme ported to numpy and scipy.sparse (splu)"
+    try:
+        res = portlib.run_port(scene, repeat)
+    except ValueError as exc:  # another scheme, law or loads: no port
+        return {"method": description, "wall_time": None, "error": None, "converged": False,
+                "reason": f"not applicable: {exc}"}
+    total, ref = res.solution.total_friction, ours.solution.total_friction
+    diff = abs(total - ref) / abs(ref) if ref != 0.0 else abs(total)
+    same = diff <= peerlib.SAME_STATE
+    converged = bool(res.converged and same)
+    entry = {"method": description, "wall_time": res.wall_time,
+             "error": relative_error(total, exact), "converged": converged,
+             "reason": ("steady" if converged else
+                        res.reason or ("steady, but a different state" if res.converged
+                                       else "not steady")),
+             "total_friction": float(total), "total_friction_vs_ours": float(diff),
+             "simulated_time": res.simulated_time, "ours_simulated_time": ours.simulated_time,
+             "steps": int(res.steps), "ours_steps": int(ours.steps),
+             "newton_iterations": int(res.statistics["newton_iterations"]),
+             "ours_newton_iterations": int(ours.statistics.get("newton_iterations", 0)),
+             "rejected_steps": int(res.statistics["rejected_steps"])}
+    log(f"port   ({description}): {res.steps} steps (ours {ours.steps}), "
+        f"{entry['newton_iterations']} Newton iterations, t = {res.simulated_time:.4g} s, "
+        f"wall {res.wall_time:.4f} s, total friction {total:.10g} N ({diff:.1e} from ours), "
+        f"{'steady' if converged else entry['reason']}")
+    return entry
+
+
 def bench(scene_path, overrides=(), peer=True, cold=True, elements=None, repeat=3,
-          peer_cap=DEFAULT_PEER_CAP, search=False, log=print) -> dict:
+          peer_cap=DEFAULT_PEER_CAP, search=False, port=True, log=print) -> dict:
     """Ours against the generic peers on one grid, the explicit kernel's speed, a cold start.
 
     ``elements`` overrides numerics.elements. Keys: ``ours_*`` (the scene's scheme, the
@@ -164,7 +202,14 @@ def bench(scene_path, overrides=(), peer=True, cold=True, elements=None, repeat=
     log(f"ours   (steady): wall {steady.wall_time:.4f} s, total friction {reference:.8g} N, "
         f"error {out['ours_steady_error']:.2e}")
     out.update(peer=None, peer_wall_time=None, peer_error=None, peer_converged=False,
-               speedup=None, steady_speedup=None, kernel_speedup=None, peers=None)
+               speedup=None, steady_speedup=None, kernel_speedup=None, peers=None,
+               port=None)
+    if port:
+        out["port"] = entry = run_port_entry(scene, res, exact, repeat, log)
+        if entry["converged"]:
+            out["kernel_speedup"] = entry["wall_time"] / res.wall_time
+        log(f"kernel speedup: {_ratio(out['kernel_speedup'])} (the port's wall time over "
+            f"ours, same scheme and steps)")
     if peer:
         table = run_peers(scene, exact, reference, repeat, peer_cap, search, log)
         out["peers"] = table
