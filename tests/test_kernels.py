@@ -18,7 +18,6 @@ from beltsim.physics.model import (
     Loads,
     State,
     assemble,
-    block_solve,
     blocks_to_dense,
     hermite_weights,
     load_at,
@@ -143,14 +142,20 @@ def test_jacobian_matches_finite_differences(law_name, inv_dt):
     np.testing.assert_allclose(J / scale, Jfd / scale, atol=1e-5)
 
 
-def test_block_solve_matches_dense():
+def test_block_factor_matches_dense_on_a_tridiagonal_system():
+    """Newton's block LU without the second lower band (a stick or quasistatic row)."""
     rng = np.random.default_rng(4)
     n = 30
-    Lb, Db, Ub = (rng.standard_normal((n, 2, 2)) for _ in range(3))
+    w = Workspace.allocate(n + 1)
+    Lb, Db, Ub = w.Lb, w.Db, w.Ub
+    for a in (Lb, Db, Ub):
+        a[:] = rng.standard_normal((n, 2, 2))
+    w.L2[:] = 0.0
     Db += 6 * np.eye(2)  # diagonally dominant like the model's blocks
     r = rng.standard_normal((n, 2))
     x = np.zeros((n, 2))
-    assert block_solve(Lb, Db, Ub, r, x, np.zeros((n, 2, 2)))
+    assert block_factor(Lb, Db, Ub, w)
+    block_substitute(w, r, x)
     ref = np.linalg.solve(blocks_to_dense(Lb, Db, Ub), r.ravel())
     np.testing.assert_allclose(x.ravel(), ref, rtol=1e-10, atol=1e-12)
 

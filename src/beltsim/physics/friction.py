@@ -53,6 +53,17 @@ def law_inverse(code, lam):
     return lam / math.sqrt(q), 1.0 / (q * math.sqrt(q))  # SQRT
 
 
+def law_inverse_numpy(code, lam):
+    """Vectorised twin of :func:`law_inverse` (the numpy port of the default scheme)."""
+    lam = np.asarray(lam, dtype=float)
+    if code == LINEAR:
+        return lam, np.ones_like(lam)
+    q = 1.0 - lam * lam
+    if code == TANH:
+        return np.arctanh(lam), 1.0 / q
+    return lam / np.sqrt(q), 1.0 / (q * np.sqrt(q))  # SQRT
+
+
 def has_dual(code) -> bool:
     """Whether the primal-dual iteration applies (the ramp's inverse is set-valued)."""
     return code != RAMP

@@ -33,7 +33,6 @@ bands, one upper: the friction stencil's j - 2).
 
 from __future__ import annotations
 
-import math
 from typing import NamedTuple
 
 import numpy as np
@@ -367,51 +366,6 @@ def update_multipliers(lam, dx, inv_dt, mesh, p, w):
         if abs(dl) > big:
             big = abs(dl)
     return big
-
-
-@njit(cache=True)
-def block_solve(Lb, Db, Ub, r, x, C):
-    """Solve the block-tridiagonal system (2x2 blocks) by block Thomas; r is kept.
-
-    C is workspace (n, 2, 2). Returns False on a singular pivot block.
-    """
-    n = Db.shape[0]
-    y0 = np.empty(n)
-    y1 = np.empty(n)
-    for i in range(n):
-        c00, c01 = Db[i, 0, 0], Db[i, 0, 1]
-        c10, c11 = Db[i, 1, 0], Db[i, 1, 1]
-        r0, r1 = r[i, 0], r[i, 1]
-        if i > 0:
-            p00, p01, p10, p11 = C[i - 1, 0, 0], C[i - 1, 0, 1], C[i - 1, 1, 0], C[i - 1, 1, 1]
-            det = p00 * p11 - p01 * p10
-            # W = L_i C_{i-1}^{-1}
-            l00, l01, l10, l11 = Lb[i, 0, 0], Lb[i, 0, 1], Lb[i, 1, 0], Lb[i, 1, 1]
-            w00 = (l00 * p11 - l01 * p10) / det
-            w01 = (-l00 * p01 + l01 * p00) / det
-            w10 = (l10 * p11 - l11 * p10) / det
-            w11 = (-l10 * p01 + l11 * p00) / det
-            u00, u01, u10, u11 = Ub[i - 1, 0, 0], Ub[i - 1, 0, 1], Ub[i - 1, 1, 0], Ub[i - 1, 1, 1]
-            c00 -= w00 * u00 + w01 * u10
-            c01 -= w00 * u01 + w01 * u11
-            c10 -= w10 * u00 + w11 * u10
-            c11 -= w10 * u01 + w11 * u11
-            r0 -= w00 * y0[i - 1] + w01 * y1[i - 1]
-            r1 -= w10 * y0[i - 1] + w11 * y1[i - 1]
-        C[i, 0, 0], C[i, 0, 1], C[i, 1, 0], C[i, 1, 1] = c00, c01, c10, c11
-        y0[i], y1[i] = r0, r1
-    for i in range(n - 1, -1, -1):
-        r0, r1 = y0[i], y1[i]
-        if i < n - 1:
-            r0 -= Ub[i, 0, 0] * x[i + 1, 0] + Ub[i, 0, 1] * x[i + 1, 1]
-            r1 -= Ub[i, 1, 0] * x[i + 1, 0] + Ub[i, 1, 1] * x[i + 1, 1]
-        c00, c01, c10, c11 = C[i, 0, 0], C[i, 0, 1], C[i, 1, 0], C[i, 1, 1]
-        det = c00 * c11 - c01 * c10
-        if det == 0.0 or not math.isfinite(det):
-            return False
-        x[i, 0] = (c11 * r0 - c01 * r1) / det
-        x[i, 1] = (-c10 * r0 + c00 * r1) / det
-    return True
 
 
 def traction(fnode, wf):

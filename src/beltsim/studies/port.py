@@ -36,8 +36,8 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import NumericalError
-from ..physics.friction import SQRT, TANH
-from ..physics.model import LAM_MAX, POWER_TERMS
+from ..physics.friction import SQRT, TANH, law_inverse_numpy, law_numpy
+from ..physics.model import LAM_MAX, POWER_TERMS, strain_numpy
 from ..problem.drive import friction_factor, mismatch
 from ..simulation.controller import Simulation
 from ..solvers.base import Scheme
@@ -50,25 +50,6 @@ from ..solvers.implicit import (
     ImplicitScheme,
 )
 from ..solvers.newton import CONTRACTION, LAW_GAP, NEAR_BOUND, ROUNDOFF_FLOOR
-
-
-def law_np(code, s):
-    """g(s) of the saturating laws (numpy)."""
-    if code == TANH:
-        return np.tanh(s)
-    if code == SQRT:
-        return s / np.sqrt(1.0 + s * s)
-    raise ValueError("the port supports the tanh and sqrt laws")
-
-
-def law_inverse_np(code, lam):
-    """g^{-1}(lam) and its derivative (numpy twin of friction.law_inverse)."""
-    q = 1.0 - lam * lam
-    if code == TANH:
-        return np.arctanh(lam), 1.0 / q
-    if code == SQRT:
-        return lam / np.sqrt(q), 1.0 / (q * np.sqrt(q))
-    raise ValueError("the port supports the tanh and sqrt laws")
 
 
 class BandPattern:
@@ -208,12 +189,8 @@ class PortScheme(Scheme):
 
     # the model ----------------------------------------------------------------
     def strain(self, ub):
-        """d/dx u_b at the contact nodes (stencil offsets -2..+1, in order)."""
-        jc, sw = self.jc, self.swc
-        e = sw[:, 0] * ub[jc - 2]
-        e = e + sw[:, 1] * ub[jc - 1]
-        e = e + sw[:, 2] * ub[jc]
-        return e + sw[:, 3] * ub[np.minimum(jc + 1, ub.size - 1)]
+        """d/dx u_b at the contact nodes."""
+        return strain_numpy(ub, self.disc.mesh.sw, self.jc)
 
     def assemble(self, u, th, lam, fnode, old, inv_dt, t, want_jac=True) -> Assembly:
         """Vectorised :func:`beltsim.physics.model.assemble` (primal-dual form)."""
@@ -242,7 +219,7 @@ class PortScheme(Scheme):
         ub = u + hh * th
         ubo = uo + hh * tho
         vrel = (ub[jc] - ubo[jc]) * inv_dt + c * self.strain(ub) - target
-        gi, dgi = law_inverse_np(p.law, lam[jc])
+        gi, dgi = law_inverse_numpy(p.law, lam[jc])
         rl = vrel / vreg - gi
         sg = 1.0 / dgi
         wfs = self.wf * fs
@@ -312,8 +289,8 @@ class PortScheme(Scheme):
         cand = (asm.sg < NEAR_BOUND) & (lj * asm.rl < 0.0)
         if not cand.any():
             return False
-        s = asm.rl[cand] + law_inverse_np(code, lam0[cand])[0]
-        off = np.abs(law_np(code, s) - lj[cand]) > LAW_GAP
+        s = asm.rl[cand] + law_inverse_numpy(code, lam0[cand])[0]
+        off = np.abs(law_numpy(code, s)[0] - lj[cand]) > LAW_GAP
         if not off.any():
             return False
         idx = jc[cand][off]
