@@ -1,9 +1,19 @@
-"""Friction laws: regularised Coulomb, and the unlimited law of perfect adhesion.
+"""Friction laws: regularised and exact Coulomb, regularised and exact adhesion.
 
-The traction on the belt is f = -f_s g(v_rel / v_reg), with g odd, increasing
-and (for Coulomb) saturating at 1. Perfect adhesion is the "linear" law
-g(s) = s with a stiff slope f_s / v_reg; as v_reg -> 0 (Coulomb) or the slope
--> infinity (adhesion) the regularised problem tends to the exact one.
+The traction on the belt is f = -f_s lam. The regularised laws give the friction
+ratio as lam = g(v_rel / v_reg), with g odd, increasing and (for Coulomb) saturating
+at 1; perfect adhesion is the "linear" law g(s) = s with a stiff slope f_s / v_reg.
+As v_reg -> 0 (Coulomb) or the slope -> infinity (adhesion) they tend to the exact
+laws, which are set-valued and carry no regularisation:
+
+* EXACT (Coulomb): |lam| <= 1 where v_rel = 0, lam = sign(v_rel) where it slides;
+* ADHESION: v_rel = 0, lam unbounded (the contact's reaction).
+
+Both are written as lam = proj(lam + v_rel / v_aug) (Alart and Curnier's
+complementarity function; proj onto [-1, 1] for Coulomb, the identity for adhesion),
+which holds for any v_aug > 0 exactly when the law does: v_aug is a numerical scale
+of the iteration (how fast stick converges), not a regularisation, and the solution
+does not depend on it.
 """
 
 from __future__ import annotations
@@ -13,13 +23,32 @@ import math
 import numpy as np
 from numba import njit
 
-LINEAR, TANH, SQRT, RAMP = 0, 1, 2, 3
-LAW_CODES = {"linear": LINEAR, "tanh": TANH, "sqrt": SQRT, "ramp": RAMP}
+LINEAR, TANH, SQRT, RAMP, EXACT, ADHESION = 0, 1, 2, 3, 4, 5
+LAW_CODES = {"linear": LINEAR, "tanh": TANH, "sqrt": SQRT, "ramp": RAMP, "exact": EXACT,
+             "adhesion": ADHESION}
+
+
+# v_aug over the default regularisation velocity (settings): v_aug = |v - c|, the scale
+# of the slip velocities. The stick/slip test lam + v_rel / v_aug then follows the
+# ratio near the slip front: with v_aug = 1e-4 |v - c| a node whose slip velocity had
+# the wrong sign in one iterate jumped to the opposite slip, skipping stick, and the
+# semi-smooth Newton cycled on the paper slip scene; from 1e-2 |v - c| up it converges
+# in two iterations from the regularised steady state (200 elements)
+AUGMENTATION = 1e4
+
+
+def is_exact(code) -> bool:
+    """Whether the law is set-valued (solved by augmentation, without regularisation)."""
+    return code >= EXACT
 
 
 @njit(cache=True)
 def law(code, s):
-    """g(s) and g'(s) of the regularisation ``code``."""
+    """g(s) and g'(s) of the regularisation ``code``.
+
+    The exact laws have none: EXACT answers with the projection of s onto [-1, 1]
+    (lam = proj(0 + s), the first augmented estimate from lam = 0), ADHESION with s.
+    """
     if code == TANH:
         # through exp, which is cheaper than libm's tanh; exact to round-off
         e = math.exp(-2.0 * abs(s))
@@ -28,7 +57,7 @@ def law(code, s):
     if code == SQRT:
         r = 1.0 / math.sqrt(1.0 + s * s)
         return s * r, r * r * r
-    if code == RAMP:
+    if code == RAMP or code == EXACT:
         if s > 1.0:
             return 1.0, 0.0
         if s < -1.0:
@@ -78,11 +107,13 @@ def law_numpy(code, s):
     if code == SQRT:
         r = 1.0 / np.sqrt(1.0 + s * s)
         return s * r, r**3
-    if code == RAMP:
+    if code in (RAMP, EXACT):
         return np.clip(s, -1.0, 1.0), (np.abs(s) <= 1.0).astype(float)
     return s, np.ones_like(s)
 
 
 def saturation(code) -> float:
-    """Level of |g| above which an element counts as sliding."""
+    """Level of |g| above which an element counts as sliding (adhesion never slides)."""
+    if code == ADHESION:
+        return math.inf
     return 0.99 if code in (TANH, SQRT) else 1.0 - 1e-12

@@ -39,7 +39,7 @@ import numpy as np
 from numba import njit
 
 from ..problem.drive import friction_factor, mismatch
-from .friction import LINEAR, has_dual, law, law_inverse, law_numpy
+from .friction import ADHESION, AUGMENTATION, EXACT, LINEAR, TANH, has_dual, law, law_inverse, law_numpy
 
 # |lam| bound in the primal-dual iteration: the friction of a fully sliding node is
 # then f* (1 - 1e-14), and g^{-1} stays finite
@@ -169,6 +169,17 @@ def model_params(P, damping, friction_scale, v_reg, law_code) -> ModelParams:
         v_reg=v_reg, law=law_code, dual=dual)
 
 
+def regularised(p: ModelParams) -> ModelParams:
+    """The regularised twin of an exact law, the exact law's starting point: tanh with the
+    default v_reg = v_aug / AUGMENTATION for Coulomb, the linear law of the default
+    adhesion layer (slope f_s / v_aug) for adhesion."""
+    if p.law == EXACT:
+        return p._replace(law=TANH, dual=1, v_reg=p.v_reg / AUGMENTATION)
+    if p.law == ADHESION:
+        return p._replace(law=LINEAR, dual=0)
+    return p
+
+
 # How the transport c d/dx u_b of the slip velocity is discretised (contact_stencil).
 TRANSPORT = "bdf2"
 TRANSPORTS = ("upwind", "bdf2", "central", "nodal1")
@@ -248,6 +259,12 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
     condensed node by node into the (u, theta) rows so the Jacobian keeps its
     block band (two lower block bands from the friction stencil, one upper). w.sg
     receives the slope dlam/d(v_rel / v_reg) used by :func:`update_multipliers`.
+
+    The exact laws (friction.EXACT, ADHESION; p.v_reg is then the augmentation
+    velocity v_aug) keep lam as a full unknown of a semi-smooth Newton iteration
+    (:mod:`beltsim.solvers.ssn`): its force enters as it is, with no Jacobian entry
+    here; rl receives v_rel / v_aug and sg 1 where lam + rl projects inside [-1, 1]
+    (stick) and 0 where it slides.
     """
     N = u.shape[0] - 1
     B, A, b2 = p.tension_eff, p.bending_eff, p.shear
@@ -301,6 +318,18 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
             ub = u[j] + hh * th[j]
             ubo = uo[j] + hh * tho[j]
             vrel = (ub - ubo) * inv_dt + c * bottom_strain(u, th, hh, sw, j) - target
+            if code >= EXACT:
+                # lam is the semi-smooth Newton's own unknown (solvers.ssn): its force
+                # enters as it is; rl: v_rel / v_aug; sg: 1 where proj(lam + rl) sticks
+                rl[j] = vrel / vreg
+                z = lam[j] + rl[j]
+                sg[j] = 0.0 if code == EXACT and abs(z) >= 1.0 else 1.0
+                fnode[j] = -wf[j] * fs * lam[j]
+                ru += wf[j] * fs * lam[j]
+                rt += hh * wf[j] * fs * lam[j]
+                R[i, 0] = ru
+                R[i, 1] = rt
+                continue
             if dual:
                 gi, dgi = law_inverse(code, lam[j])
                 rl[j] = vrel / vreg - gi
@@ -313,27 +342,32 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
             ru += wj * fs * (lam[j] + sg[j] * rl[j])
             rt += hh * wj * fs * (lam[j] + sg[j] * rl[j])
             if want_jac:
-                k = wj * fs * sg[j] / vreg  # -dF/dv_rel
-                for o in range(4):
-                    dd = k * c * sw[j, o]
-                    if o == 2:
-                        dd += k * inv_dt
-                    if dd == 0.0:
-                        continue
-                    if o == 0:
-                        blk = L2
-                    elif o == 1:
-                        blk = Lb
-                    elif o == 2:
-                        blk = Db
-                    else:
-                        blk = Ub
-                    blk[i, 0, 0] += dd
-                    blk[i, 0, 1] += dd * hh
-                    blk[i, 1, 0] += dd * hh
-                    blk[i, 1, 1] += dd * hh * hh
+                add_friction_slope(w, i, j, wj * fs * sg[j] / vreg, inv_dt, c, hh, sw)
         R[i, 0] = ru
         R[i, 1] = rt
+
+
+@njit(cache=True)
+def add_friction_slope(w, i, j, k, inv_dt, c, hh, sw):
+    """Add to row block i the Jacobian of a nodal force -k v_rel,j (k = -dF_j/dv_rel)."""
+    for o in range(4):
+        dd = k * c * sw[j, o]
+        if o == 2:
+            dd += k * inv_dt
+        if dd == 0.0:
+            continue
+        if o == 0:
+            blk = w.L2
+        elif o == 1:
+            blk = w.Lb
+        elif o == 2:
+            blk = w.Db
+        else:
+            blk = w.Ub
+        blk[i, 0, 0] += dd
+        blk[i, 0, 1] += dd * hh
+        blk[i, 1, 0] += dd * hh
+        blk[i, 1, 1] += dd * hh * hh
 
 
 @njit(cache=True)

@@ -197,7 +197,7 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "t_end": POS,
         "ramp_time": _Rule("float", nonneg=True),
         "regularisation": POS,
-        "friction_law": _Rule("str", choices=("tanh", "sqrt", "ramp")),
+        "friction_law": _Rule("str", choices=("tanh", "sqrt", "ramp", "exact")),
         "adhesion_layer": POS,
         "acceleration": _Rule("float", nonneg=True),
         "time_tol": POS,
@@ -214,8 +214,7 @@ OPTIONAL_SECTIONS = ("stiffness", "numerics")
 TOP_LEVEL_KEYS = ("title",)
 
 # Keys that only make sense for some scenes ("a scene holds only what it needs").
-_ONLY_COULOMB = {("contact", "max_friction"), ("numerics", "regularisation"),
-                 ("numerics", "friction_law")}
+_ONLY_COULOMB = {("contact", "max_friction"), ("numerics", "regularisation")}
 _ONLY_STICK = {("numerics", "adhesion_layer")}
 # (physics.damping, like beam.density, describes the belt and is ignored without inertia)
 _ONLY_INERTIA = {("stiffness", "mass"), ("stiffness", "rotary_inertia"),
@@ -298,6 +297,15 @@ def validate(data: dict) -> dict:
         if key in out.get(section, {}) and friction != "stick":
             raise SceneError(f'{section}.{key}: only for contact.friction = "stick" '
                              f'(this scene is "{friction}")')
+    law = out.get("numerics", {}).get("friction_law")
+    if friction == "stick" and law not in (None, "exact"):
+        raise SceneError(f'numerics.friction_law: a "stick" scene takes only "exact" (exact '
+                         f'adhesion) or none (the adhesion layer), got "{law}"')
+    if law == "exact":
+        for key in ("regularisation", "adhesion_layer"):
+            if key in out["numerics"]:
+                raise SceneError(f'numerics.{key}: not with numerics.friction_law = "exact" '
+                                 f"(exact friction has no regularisation)")
     for section, key in _ONLY_INERTIA:
         if key in out.get(section, {}) and not inertia:
             raise SceneError(f"{section}.{key}: only for physics.inertia = true "

@@ -17,10 +17,11 @@ import numpy as np
 from numba import njit
 
 from ..errors import NumericalError
-from ..physics.friction import law, law_inverse
-from ..physics.model import assemble, update_multipliers
+from ..physics.friction import AUGMENTATION, EXACT, is_exact, law, law_inverse
+from ..physics.model import add_friction_slope, assemble, update_multipliers
 from ..problem.drive import friction_factor
 from .base import Scheme
+from .ssn import Saddle, project, saddle_factor, saddle_substitute, saddle_system
 
 # status codes of the time-stepping kernels that solve with Newton
 OK, FAILED, NONFINITE = 0, 1, 2
@@ -67,9 +68,10 @@ class Workspace(NamedTuple):
     sgf: np.ndarray  # those of the factorised Jacobian
     lam0: np.ndarray  # friction ratios before the last update (N + 1)
     stats: np.ndarray  # one record of STATS_DTYPE
+    saddle: Saddle  # the exact laws' 3x3 system (empty for the regularised ones)
 
     @classmethod
-    def allocate(cls, n_elements: int) -> "Workspace":
+    def allocate(cls, n_elements: int, exact: bool = False) -> "Workspace":
         N, n = n_elements, n_elements - 1
         return cls(R=np.zeros((n, 2)), Lb=np.zeros((n, 2, 2)), L2=np.zeros((n, 2, 2)),
                    Db=np.zeros((n, 2, 2)),
@@ -78,7 +80,8 @@ class Workspace(NamedTuple):
                    U=np.zeros((n, 2, 2)), dx=np.zeros((n, 2)),
                    u_try=np.zeros(N + 1), th_try=np.zeros(N + 1), rl=np.zeros(N + 1),
                    sg=np.zeros(N + 1), sgf=np.zeros(N + 1), lam0=np.zeros(N + 1),
-                   stats=np.zeros(1, STATS_DTYPE))
+                   stats=np.zeros(1, STATS_DTYPE),
+                   saddle=Saddle.allocate(N) if exact else Saddle.empty())
 
 
 @njit(cache=True)
@@ -202,6 +205,8 @@ def release_stuck_ratios(lam, w, mesh, code):
     1 + 2 |rl| per iteration), and Newton goes on.
     """
     stuck = False
+    if code >= EXACT:  # a projected ratio sits on the bound exactly when it slides
+        return stuck
     for j in range(mesh.c0, mesh.j2 + 1):
         if w.sg[j] < NEAR_BOUND and lam[j] * w.rl[j] < 0.0:
             s = w.rl[j] + law_inverse(code, w.lam0[j])[0]
@@ -227,6 +232,8 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     and the friction slopes it was assembled with (w.sgf), for the step's error
     estimate. Returns True on convergence.
     """
+    if p.law >= EXACT:
+        return newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w)
     u, th, lam, fnode = state.u, state.theta, state.lam, state.fnode
     R, dx, u_try, th_try = w.R, w.dx, w.u_try, w.th_try
     st = w.stats[0]
@@ -301,13 +308,71 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     return False
 
 
+@njit(cache=True)
+def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
+    """Semi-smooth Newton on (u, theta, lam) for the exact laws (:mod:`.ssn`).
+
+    Full steps; converged when the update passes :func:`newton`'s tests and the
+    stick/slip state of every friction node is the one the last step was solved with.
+    On return, w holds the block LU of the 2x2 Jacobian with the stuck nodes' slope
+    f_s AUGMENTATION / v_aug, the default regularisation's (a penalty standing in for
+    their constraint), for the step's error estimate, as :func:`newton` leaves its own.
+    """
+    u, th, lam, fnode = state.u, state.theta, state.lam, state.fnode
+    s = w.saddle
+    st = w.stats[0]
+    tol = settings.tol
+    n = w.R.shape[0]
+    fs = p.friction_scale * friction_factor(drive, t)
+    for j in range(s.active.shape[0]):
+        s.active[j] = -1.0
+    assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+    saddle_system(lam, inv_dt, fs, mesh, p, w, s)
+    previous = np.inf
+    for it in range(settings.max_iterations):
+        st.newton_iterations += 1
+        if not saddle_factor(s):
+            st.merit = merit(w.R, scales)
+            return False
+        saddle_substitute(s)
+        step = 0.0
+        dlam = 0.0
+        for i in range(n):
+            step = max(step, abs(s.dx[i, 0]) / scales.u, abs(s.dx[i, 1]) / scales.theta)
+            dlam = max(dlam, abs(s.dx[i, 2]))
+        if not (np.isfinite(step) and np.isfinite(dlam)):
+            st.merit = merit(w.R, scales)
+            return False
+        for i in range(n):
+            u[i + 1] += s.dx[i, 0]
+            th[i + 1] += s.dx[i, 1]
+        for j in range(mesh.c0, mesh.j2 + 1):
+            lam[j] += s.dx[j - 1, 2]
+        project(lam, mesh, p.law)
+        assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+        changed = saddle_system(lam, inv_dt, fs, mesh, p, w, s)
+        update = max(step, dlam)
+        rate = update / previous if it > 0 and previous > 0.0 else 1.0
+        previous = update
+        if changed == 0 and (update < tol
+                             or (update < ROUNDOFF_FLOOR * tol and rate > 0.5)
+                             or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol)):
+            for j in range(mesh.c0, mesh.j2 + 1):
+                w.sg[j] *= AUGMENTATION  # the default regularisation's slope in stick
+                add_friction_slope(w, j - 1, j, mesh.wf[j] * fs * w.sg[j] / p.v_reg, inv_dt,
+                                   p.speed, p.half_height, mesh.sw)
+            return factorise(w, mesh)
+    st.merit = merit(w.R, scales)
+    return False
+
+
 class NewtonScheme(Scheme):
     """The workspace, Newton settings and counters of the schemes that solve with Newton."""
 
     def __init__(self, disc):
         super().__init__(disc)
         num = self.numerics
-        self.work = Workspace.allocate(disc.grid.n_elements)
+        self.work = Workspace.allocate(disc.grid.n_elements, is_exact(disc.model.law))
         self.settings = NewtonSettings(num.newton_tol, num.newton_max_it)
         # the previous step's state (with inv_dt = 0, the steady equations ignore it)
         self.old = disc.new_state()

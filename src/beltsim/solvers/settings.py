@@ -19,6 +19,9 @@ Defaults (all overridable in [numerics]):
 * ``adhesion_layer`` (stick) delta = 1e-6 L: perfect adhesion is the linear law
   f = -kappa v_rel with kappa = (b1 - rho c^2) / (c delta), which spreads the
   concentrated force over a layer of width delta upstream of x2;
+* ``friction_law`` "tanh" (coulomb), the adhesion layer (stick); "exact" for either:
+  the set-valued law without regularisation (Coulomb, or exact adhesion), solved by a
+  semi-smooth Newton (solvers.ssn) with the augmentation velocity v_aug = |v - c|;
 * ``acceleration`` (the pseudo-transient scheme only) 2 omega_1 with
   omega_1 = pi (b1 - rho c^2) / (L sqrt(rho b1)), the lowest axial frequency of the
   domain: a damping of u_t and theta_t on top of the scene's own, which changes the
@@ -46,7 +49,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import SceneError
-from ..physics.friction import LAW_CODES
+from ..physics.friction import AUGMENTATION, LAW_CODES
 from ..physics.grid import Grid, make_grid
 from ..problem import analytic
 from ..problem.analytic import decay_rates
@@ -66,6 +69,7 @@ DEFAULT_MAX_WORK = 2e10  # node-steps of an explicit run
 EXPLICIT_RATE = 3e7  # node-steps per second of the explicit kernel (bench), for messages
 MEMORY_PER_NODE = 600  # bytes a grid node costs a run at its peak
 MIN_VREG = 1e-12  # smallest regularisation velocity, relative to c
+DEFAULT_ADHESION_LAYER = 1e-6  # delta / L
 
 
 @dataclass(frozen=True)
@@ -112,18 +116,27 @@ def resolve(scene: Scene) -> Numerics:
             f"but not 0: in double precision v - c then carries a round-off of "
             f"{2.2e-16 / abs(P.e0):.1%} and the friction law cannot resolve it; use v = c "
             f"for the zero state")
-    if P.friction == "coulomb":
-        dv = abs(P.v - P.c)
-        if dv == 0.0 or period_of(scene) is not None:
-            dv = largest_mismatch(scene)
-        vreg = nm.get("regularisation", 1e-4 * dv if dv > 0 else 1e-6 * P.c)
+    dv = abs(P.v - P.c)
+    if dv == 0.0 or period_of(scene) is not None:
+        dv = largest_mismatch(scene)
+    default_vreg = 1e-4 * dv if dv > 0 else 1e-6 * P.c
+    if nm.get("friction_law") == "exact":
+        # v_aug: the augmentation velocity, numerical only (physics.friction). For
+        # adhesion f_s makes f_s / v_aug the default adhesion layer's slope B / (c delta)
+        vreg = AUGMENTATION * default_vreg
+        if P.friction == "coulomb":
+            law, fs = "exact", P.fstar
+        else:
+            law, fs = "adhesion", P.B * vreg / (P.c * DEFAULT_ADHESION_LAYER * P.L)
+    elif P.friction == "coulomb":
+        vreg = nm.get("regularisation", default_vreg)
         law, fs = nm.get("friction_law", "tanh"), P.fstar
         if vreg < MIN_VREG * P.c:
             raise SceneError(f"numerics.regularisation: must be >= {MIN_VREG:g} c = "
                              f"{MIN_VREG * P.c:.3g} m/s (below it slip velocities drown in "
                              f"round-off), got {vreg!r}")
     else:
-        delta = nm.get("adhesion_layer", 1e-6 * P.L)
+        delta = nm.get("adhesion_layer", DEFAULT_ADHESION_LAYER * P.L)
         law, vreg = "linear", 1.0
         fs = P.B / (P.c * delta)
     accelerated = registry.get(integrator).accelerated

@@ -13,6 +13,8 @@ discrete steady state as the transient schemes.
 from __future__ import annotations
 
 from ..errors import NumericalError
+from ..physics.friction import is_exact
+from ..physics.model import regularised
 from ..problem.drive import Drive
 from .newton import NewtonScheme, NewtonSettings, newton
 from .registry import register
@@ -43,18 +45,32 @@ class SteadyScheme(NewtonScheme):
 
     def solve(self, state) -> None:
         """Continuation in v - c (after one in v_reg for a saturating law); the number of
-        stages is counted as steps.
+        stages is counted as steps. An exact law first solves its regularised twin
+        (physics.model.regularised) so, and then itself from there at full speed: the
+        semi-smooth Newton cycles from rest, where every node's stick/slip state is
+        wrong, and converges from the twin's (a few iterations).
 
         Raises NumericalError when the stage falls below MIN_STAGE of the mismatch.
         """
         model = self.disc.model
-        if model.dual:
-            self.disc.model = model._replace(v_reg=REGULARISATION_START * model.v_reg)
-            try:
+        exact = is_exact(model.law)
+        smooth = regularised(model) if exact else model
+        try:
+            if smooth.dual:
+                self.disc.model = smooth._replace(v_reg=REGULARISATION_START * smooth.v_reg)
                 self._continue_in_speed(state)
-            finally:
-                self.disc.model = model
-        self._continue_in_speed(state)
+            self.disc.model = smooth
+            self._continue_in_speed(state)
+        finally:
+            self.disc.model = model
+        if exact:
+            self.steps += 1
+            if not self._stage(state, 1.0, self.settings._replace(
+                    max_iterations=STAGE_ITERATIONS * self.settings.max_iterations)):
+                raise NumericalError(
+                    "steady semi-smooth Newton iteration of the exact friction law did not "
+                    "converge from its regularised twin's steady state", t=0.0,
+                    quantity="newton")
 
     def _continue_in_speed(self, state) -> None:
         stage_settings = self.settings._replace(

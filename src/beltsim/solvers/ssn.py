@@ -1,0 +1,214 @@
+"""Exact friction: the semi-smooth Newton system with the friction ratios as unknowns.
+
+With the set-valued laws (physics.friction.EXACT, ADHESION) the friction ratio lam_j of
+each friction node is an unknown beside (u_j, theta_j), with Alart and Curnier's
+complementarity equation lam = proj(lam + v_rel / v_aug). Its generalised Jacobian
+row at a node that sticks (lam + v_rel / v_aug inside [-1, 1]; always for adhesion) is
+that of v_rel / v_aug (the stick constraint: the ratio itself has no entry), at a
+node that slides that of lam - sign. The stick rows cannot be condensed into the
+(u, theta) rows node by node as the regularised laws' are (an augmented Lagrangian
+that tried diverged on the paper slip scene: the transport makes the friction-to-slip
+compliance non-symmetric with eigenvalues near -v_aug), so the system is solved
+whole: per interior node the unknowns (u_j, theta_j, lam_j) (lam_j = 0, identity row,
+off the friction nodes), 3x3 blocks with the same band as the model's 2x2 Jacobian
+(two lower bands from the friction stencil, one upper), factorised by block LU with
+each 3x3 pivot inverted whole (the stick rows have a zero diagonal entry; the pivot
+block is regular where c sw_jj + inv_dt > 0).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from ..physics.friction import EXACT
+
+
+class Saddle(NamedTuple):
+    """The 3x3 block-banded system and its block LU (n interior nodes)."""
+
+    L2: np.ndarray  # (n, 3, 3) bands
+    Lb: np.ndarray
+    Db: np.ndarray
+    Ub: np.ndarray
+    C: np.ndarray  # inverse pivots
+    W: np.ndarray  # multipliers of the first and second lower band
+    W2: np.ndarray
+    R: np.ndarray  # right-hand side (n, 3)
+    dx: np.ndarray  # solution (n, 3)
+    active: np.ndarray  # (N + 1) 1 where the node sticks, at the last assembly
+
+    @classmethod
+    def allocate(cls, n_elements: int) -> "Saddle":
+        n = max(n_elements - 1, 0)
+        z = np.zeros
+        return cls(z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)),
+                   z((n, 3, 3)), z((n, 3, 3)), z((n, 3)), z((n, 3)), z(n_elements + 1))
+
+    @classmethod
+    def empty(cls) -> "Saddle":
+        return cls.allocate(0)
+
+
+@njit(cache=True)
+def saddle_system(lam, inv_dt, fs, mesh, p, w, s):
+    """The 3x3 blocks and right-hand side -F of the semi-smooth Newton step.
+
+    w holds the model's 2x2 blocks and residual as :func:`beltsim.physics.model.assemble`
+    leaves them for an exact law (friction force wf f_s lam in the residual, no friction
+    slope; w.rl = v_rel / v_aug, w.sg = 1 where the node sticks). Returns the number of
+    friction nodes whose stick/slip state differs from the previous call's.
+    """
+    n = w.R.shape[0]
+    c, hh, vaug = p.speed, p.half_height, p.v_reg
+    changed = 0
+    for i in range(n):
+        for a in range(3):
+            s.R[i, a] = 0.0
+            for b in range(3):
+                s.L2[i, a, b] = 0.0
+                s.Lb[i, a, b] = 0.0
+                s.Db[i, a, b] = 0.0
+                s.Ub[i, a, b] = 0.0
+        for a in range(2):
+            s.R[i, a] = -w.R[i, a]
+            for b in range(2):
+                s.L2[i, a, b] = w.L2[i, a, b]
+                s.Lb[i, a, b] = w.Lb[i, a, b]
+                s.Db[i, a, b] = w.Db[i, a, b]
+                s.Ub[i, a, b] = w.Ub[i, a, b]
+        j = i + 1
+        if j < mesh.c0 or j > mesh.j2:
+            s.Db[i, 2, 2] = 1.0
+            s.R[i, 2] = -lam[j]
+            continue
+        k = mesh.wf[j] * fs
+        s.Db[i, 0, 2] = k
+        s.Db[i, 1, 2] = hh * k
+        stick = w.sg[j] > 0.5
+        if stick != (s.active[j] > 0.5):
+            changed += 1
+        s.active[j] = 1.0 if stick else 0.0
+        if not stick:
+            s.Db[i, 2, 2] = 1.0
+            s.R[i, 2] = -(lam[j] - math.copysign(1.0, lam[j] + w.rl[j]))
+            continue
+        s.R[i, 2] = -w.rl[j]
+        for o in range(4):
+            q = j - 2 + o
+            if q < 1 or q > n:
+                continue
+            dd = c * mesh.sw[j, o] / vaug
+            if o == 2:
+                dd += inv_dt / vaug
+            if dd == 0.0:
+                continue
+            if o == 0:
+                blk = s.L2
+            elif o == 1:
+                blk = s.Lb
+            elif o == 2:
+                blk = s.Db
+            else:
+                blk = s.Ub
+            blk[i, 2, 0] += dd
+            blk[i, 2, 1] += dd * hh
+    return changed
+
+
+@njit(cache=True)
+def _inv3(a, out):
+    """out = a^{-1} (3x3, cofactors); False when singular or not finite."""
+    c00 = a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]
+    c01 = a[1, 2] * a[2, 0] - a[1, 0] * a[2, 2]
+    c02 = a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]
+    det = a[0, 0] * c00 + a[0, 1] * c01 + a[0, 2] * c02
+    if not (abs(det) > 0.0 and abs(det) < math.inf):
+        return False
+    g = 1.0 / det
+    out[0, 0] = c00 * g
+    out[1, 0] = c01 * g
+    out[2, 0] = c02 * g
+    out[0, 1] = (a[0, 2] * a[2, 1] - a[0, 1] * a[2, 2]) * g
+    out[1, 1] = (a[0, 0] * a[2, 2] - a[0, 2] * a[2, 0]) * g
+    out[2, 1] = (a[0, 1] * a[2, 0] - a[0, 0] * a[2, 1]) * g
+    out[0, 2] = (a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]) * g
+    out[1, 2] = (a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]) * g
+    out[2, 2] = (a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]) * g
+    return True
+
+
+@njit(cache=True)
+def _mul(a, b, out):
+    for r in range(3):
+        for q in range(3):
+            acc = 0.0
+            for k in range(3):
+                acc += a[r, k] * b[k, q]
+            out[r, q] = acc
+
+
+@njit(cache=True)
+def saddle_factor(s):
+    """Block LU of the 3x3 block-banded system (as newton.block_factor for 2x2 blocks):
+    W2_i = L2_i S_{i-2}^{-1}, L'_i = L_i - W2_i U_{i-2}, W_i = L'_i S_{i-1}^{-1},
+    S_i = D_i - W_i U_{i-1}; s.C receives S_i^{-1}. Returns False on a singular pivot."""
+    n = s.Db.shape[0]
+    Li = np.empty((3, 3))
+    S = np.empty((3, 3))
+    tmp = np.empty((3, 3))
+    for i in range(n):
+        S[:, :] = s.Db[i]
+        if i > 0:
+            Li[:, :] = s.Lb[i]
+            if i > 1:
+                _mul(s.L2[i], s.C[i - 2], s.W2[i])
+                _mul(s.W2[i], s.Ub[i - 2], tmp)
+                Li -= tmp
+            else:
+                s.W2[i, :, :] = 0.0
+            _mul(Li, s.C[i - 1], s.W[i])
+            _mul(s.W[i], s.Ub[i - 1], tmp)
+            S -= tmp
+        if not _inv3(S, s.C[i]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def saddle_substitute(s):
+    """s.dx from s.R with the factors of :func:`saddle_factor`."""
+    n = s.R.shape[0]
+    y = s.dx
+    z = np.empty(3)
+    for i in range(n):
+        for a in range(3):
+            acc = s.R[i, a]
+            if i > 0:
+                for b in range(3):
+                    acc -= s.W[i, a, b] * y[i - 1, b]
+            if i > 1:
+                for b in range(3):
+                    acc -= s.W2[i, a, b] * y[i - 2, b]
+            y[i, a] = acc
+    for i in range(n - 1, -1, -1):
+        for a in range(3):
+            acc = y[i, a]
+            if i < n - 1:
+                for b in range(3):
+                    acc -= s.Ub[i, a, b] * y[i + 1, b]
+            z[a] = acc
+        for a in range(3):
+            y[i, a] = s.C[i, a, 0] * z[0] + s.C[i, a, 1] * z[1] + s.C[i, a, 2] * z[2]
+
+
+@njit(cache=True)
+def project(lam, mesh, code):
+    """Ratios of sliding nodes back onto [-1, 1] (Coulomb): the update may overshoot."""
+    if code != EXACT:
+        return
+    for j in range(mesh.c0, mesh.j2 + 1):
+        lam[j] = min(1.0, max(-1.0, lam[j]))
