@@ -65,6 +65,11 @@ r = c / sqrt(B / rho) below 1 on the paper's data. delta_{j-1} and delta_{j-2} a
 known first in a sweep in the direction of the flow, so each node is one monotone
 scalar equation.
 
+The exact laws (numerics.friction_law = "exact") are the stiff limit of that scalar
+equation, solved by projection: the node sticks (its estimated slip velocity is 0) when
+the ratio that holds it is within [-1, 1] (always for adhesion), else it slides with
+the ratio on the bound.
+
 The step is EXPLICIT_SAFETY of the limit found by a von Neumann analysis of this
 scheme (both fields, friction at all slopes with its transport) on the smallest
 element; a requested step above the limit is refused.
@@ -82,7 +87,7 @@ import numpy as np
 from numba import njit
 
 from ..errors import SceneError
-from ..physics.friction import LINEAR, RAMP, SQRT, TANH, law
+from ..physics.friction import ADHESION, EXACT, LINEAR, RAMP, SQRT, TANH, law
 from ..physics.model import contact_stencil, hermite_weights, load_at
 from ..problem.drive import friction_factor, mismatch
 from .base import Scheme
@@ -118,7 +123,7 @@ class History(NamedTuple):
 
 @njit(cache=True)
 def _friction_scalar(code, s_pred, kappa, s0):
-    """Solve s + kappa g(s) = s_pred; returns (s, g(s)).
+    """Solve s + kappa g(s) = s_pred; returns (s, g(s)) (for an exact law, g(s) in its set).
 
     g is odd, increasing and |g| <= 1 (unless linear), so the root lies in
     [s_pred - kappa, s_pred + kappa]. Newton from s0 (the node's value at the previous
@@ -130,6 +135,12 @@ def _friction_scalar(code, s_pred, kappa, s0):
     if code == LINEAR:  # closed form
         s = s_pred / (1.0 + kappa)
         return s, s
+    # the exact laws, by projection: the node sticks (s = 0) if its ratio s_pred / kappa
+    # can hold it (always for adhesion), else slides with the ratio on the bound
+    if code == ADHESION or (code == EXACT and abs(s_pred) <= kappa):
+        return 0.0, s_pred / kappa
+    if code == EXACT:
+        return (s_pred - kappa, 1.0) if s_pred > 0 else (s_pred + kappa, -1.0)
     if code == RAMP:
         if abs(s_pred) <= 1.0 + kappa:
             s = s_pred / (1.0 + kappa)

@@ -37,6 +37,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from ..physics.friction import ADHESION, EXACT
 from ..physics.model import LAM_MAX, POWER_TERMS, power_terms
 from ..problem.drive import friction_factor
 from .newton import FAILED, NONFINITE, OK, NewtonScheme, block_substitute, newton
@@ -93,16 +94,18 @@ def filtered_error(e, a0, fs, mesh, p, w, out):
 
 
 @njit(cache=True)
-def predict_friction(lam, lam_prev, r, mesh):
+def predict_friction(lam, lam_prev, r, mesh, code):
     """Extrapolate the friction ratios lam (at t_n, in place) linearly to t_n + r (t_n - t_{n-1}).
 
-    Kept inside the bounds of the primal-dual iteration (+-LAM_MAX): a node that
+    Kept inside the bounds of the primal-dual iteration (+-LAM_MAX; +-1 for exact
+    Coulomb, none for exact adhesion): a node that
     reaches slip in the step starts there, and one that the extrapolation takes to
     the bound wrongly is caught by Newton's check of the ratios at the bound
     (:func:`beltsim.solvers.newton.release_stuck_ratios`).
     """
+    bound = math.inf if code == ADHESION else (1.0 if code == EXACT else LAM_MAX)
     for j in range(mesh.c0, mesh.j2 + 1):
-        lam[j] = min(LAM_MAX, max(-LAM_MAX, lam[j] + r * (lam[j] - lam_prev[j])))
+        lam[j] = min(bound, max(-bound, lam[j] + r * (lam[j] - lam_prev[j])))
 
 
 @njit(cache=True)
@@ -163,7 +166,7 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
             u[j] = u_n[j] + h * ud_n[j] + 0.5 * h * h * hist.au[j]
             th[j] = th_n[j] + h * td_n[j] + 0.5 * h * h * hist.at[j]
         if h_prev > 0.0:
-            predict_friction(lam, hist.lam, h / h_prev, mesh)
+            predict_friction(lam, hist.lam, h / h_prev, mesh, p.law)
         ok = newton(state, base, a0, t + h, mesh, p, drive, loads, scales, settings, w)
         err = 0.0
         finite = True
