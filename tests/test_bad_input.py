@@ -47,6 +47,11 @@ CORPUS = {
     "sine sign": (PAPER.replace("max_friction = 1.0e5",
                                 "max_friction = { mean = 1e5, amplitude = 2e5, period = 1 }"),
                   "contact.max_friction: must stay > 0"),
+    "stick regularised law": (PAPER.replace('"coulomb"', '"stick"').replace(
+        "max_friction = 1.0e5", "") + '\n[numerics]\nfriction_law = "tanh"\n',
+        'numerics.friction_law: a "stick" scene takes only "exact"'),
+    "exact with v_reg": (PAPER + '\n[numerics]\nfriction_law = "exact"\nregularisation = 1e-3\n',
+                         'numerics.regularisation: not with numerics.friction_law = "exact"'),
 }
 
 

@@ -28,7 +28,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..physics.friction import law_numpy
+from ..errors import SceneError
+from ..physics.friction import is_exact, law_numpy
 from ..physics.model import forces_numpy, strain_numpy
 from ..problem.drive import Drive, friction_factor, mismatch
 from ..simulation.controller import Simulation
@@ -116,6 +117,9 @@ class PeerModel:
         self.disc = d = sim.disc
         self.scales = d.scales
         p, he, hb = d.model, d.mesh.he, d.mesh.hb
+        if is_exact(p.law):  # y' = f(y) needs a single-valued law
+            raise SceneError('numerics.friction_law: the peers take the regularised laws, '
+                             'not "exact" (a method-of-lines right-hand side is single-valued)')
         N = d.grid.n_elements
         self.n = n = N - 1
         self._full = [np.zeros(N + 1) for _ in range(4)]
