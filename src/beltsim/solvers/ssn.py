@@ -119,9 +119,9 @@ def saddle_system(lam, inv_dt, fs, mesh, p, w, s):
     return changed
 
 
-@njit(cache=True)
-def _inv3(a, out):
-    """out = a^{-1} (3x3, cofactors); False when singular or not finite."""
+@njit(cache=True, inline="always")
+def _inv3(a, out, i):
+    """out[i] = a^{-1} (3x3, cofactors); False when singular or not finite."""
     c00 = a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]
     c01 = a[1, 2] * a[2, 0] - a[1, 0] * a[2, 2]
     c02 = a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]
@@ -129,26 +129,34 @@ def _inv3(a, out):
     if not (abs(det) > 0.0 and abs(det) < math.inf):
         return False
     g = 1.0 / det
-    out[0, 0] = c00 * g
-    out[1, 0] = c01 * g
-    out[2, 0] = c02 * g
-    out[0, 1] = (a[0, 2] * a[2, 1] - a[0, 1] * a[2, 2]) * g
-    out[1, 1] = (a[0, 0] * a[2, 2] - a[0, 2] * a[2, 0]) * g
-    out[2, 1] = (a[0, 1] * a[2, 0] - a[0, 0] * a[2, 1]) * g
-    out[0, 2] = (a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]) * g
-    out[1, 2] = (a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]) * g
-    out[2, 2] = (a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]) * g
+    out[i, 0, 0] = c00 * g
+    out[i, 1, 0] = c01 * g
+    out[i, 2, 0] = c02 * g
+    out[i, 0, 1] = (a[0, 2] * a[2, 1] - a[0, 1] * a[2, 2]) * g
+    out[i, 1, 1] = (a[0, 0] * a[2, 2] - a[0, 2] * a[2, 0]) * g
+    out[i, 2, 1] = (a[0, 1] * a[2, 0] - a[0, 0] * a[2, 1]) * g
+    out[i, 0, 2] = (a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]) * g
+    out[i, 1, 2] = (a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]) * g
+    out[i, 2, 2] = (a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]) * g
     return True
 
 
-@njit(cache=True)
-def _mul(a, b, out):
+@njit(cache=True, inline="always")
+def _mul(a, ia, b, ib, out, io):
+    """out[io] = a[ia] b[ib] (3x3 blocks, by index: views would cost a reference count)."""
     for r in range(3):
+        a0, a1, a2 = a[ia, r, 0], a[ia, r, 1], a[ia, r, 2]
         for q in range(3):
-            acc = 0.0
-            for k in range(3):
-                acc += a[r, k] * b[k, q]
-            out[r, q] = acc
+            out[io, r, q] = a0 * b[ib, 0, q] + a1 * b[ib, 1, q] + a2 * b[ib, 2, q]
+
+
+@njit(cache=True, inline="always")
+def _mul_sub(a, ia, b, ib, acc):
+    """acc -= a[ia] b[ib] (acc a 3x3 array)."""
+    for r in range(3):
+        a0, a1, a2 = a[ia, r, 0], a[ia, r, 1], a[ia, r, 2]
+        for q in range(3):
+            acc[r, q] -= a0 * b[ib, 0, q] + a1 * b[ib, 1, q] + a2 * b[ib, 2, q]
 
 
 @njit(cache=True)
@@ -157,23 +165,22 @@ def saddle_factor(s):
     W2_i = L2_i S_{i-2}^{-1}, L'_i = L_i - W2_i U_{i-2}, W_i = L'_i S_{i-1}^{-1},
     S_i = D_i - W_i U_{i-1}; s.C receives S_i^{-1}. Returns False on a singular pivot."""
     n = s.Db.shape[0]
-    Li = np.empty((3, 3))
+    Li = np.empty((1, 3, 3))
     S = np.empty((3, 3))
-    tmp = np.empty((3, 3))
     for i in range(n):
-        S[:, :] = s.Db[i]
+        for r in range(3):
+            for q in range(3):
+                S[r, q] = s.Db[i, r, q]
         if i > 0:
-            Li[:, :] = s.Lb[i]
+            for r in range(3):
+                for q in range(3):
+                    Li[0, r, q] = s.Lb[i, r, q]
             if i > 1:
-                _mul(s.L2[i], s.C[i - 2], s.W2[i])
-                _mul(s.W2[i], s.Ub[i - 2], tmp)
-                Li -= tmp
-            else:
-                s.W2[i, :, :] = 0.0
-            _mul(Li, s.C[i - 1], s.W[i])
-            _mul(s.W[i], s.Ub[i - 1], tmp)
-            S -= tmp
-        if not _inv3(S, s.C[i]):
+                _mul(s.L2, i, s.C, i - 2, s.W2, i)
+                _mul_sub(s.W2, i, s.Ub, i - 2, Li[0])
+            _mul(Li, 0, s.C, i - 1, s.W, i)
+            _mul_sub(s.W, i, s.Ub, i - 1, S)
+        if not _inv3(S, s.C, i):
             return False
     return True
 
