@@ -11,6 +11,19 @@ from beltsim.studies import bench, convergence, peers
 from helpers import cli, scene_path
 
 
+def test_a_refused_rung_is_reported_and_the_ladder_goes_on(tmp_path):
+    # max_work 2e7 refuses the 240-element explicit run (~9e7 node-steps), admits 60 (~6e6)
+    proc = cli("convergence", scene_path("paper_slip"), "--ladder", "240,60", "--schemes",
+               "explicit", "--set", "numerics.max_work=2e7", "--out", str(tmp_path))
+    assert proc.returncode == 0, proc.stderr
+    table = read_csv_text(tmp_path / "convergence.csv")
+    refused, done = table
+    assert float(refused["converged"]) == 0.0
+    assert refused["reason"].startswith("numerics.max_work:")
+    assert float(done["converged"]) == 1.0 and done["reason"] == ""
+    assert "refused: numerics.max_work" in proc.stdout
+
+
 def test_convergence_command_small_ladder(tmp_path):
     proc = cli("convergence", scene_path("paper_slip"), "--ladder", "60,120,240", "--out",
                 str(tmp_path))
@@ -34,9 +47,9 @@ def test_convergence_command_small_ladder(tmp_path):
 
 
 def read_csv_text(path):
-    lines = path.read_text().splitlines()
-    header = lines[0].split(",")
-    return [dict(zip(header, line.split(","))) for line in lines[1:]]
+    import csv
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
 
 
 def test_observed_orders_recover_a_known_rate():

@@ -149,10 +149,12 @@ def cmd_convergence(args):
     print("  ".join(f"{c:>12s}" for c in cols))
 
     def show(row):
-        print("  ".join(_cell(row[c]) for c in cols), flush=True)
+        print("  ".join(_cell(row[c]) for c in cols)
+              + (f"  refused: {row['reason']}" if row["reason"] else ""), flush=True)
     rows = studies.convergence(scene, ladder, schemes, progress=show)
-    write_csv(out / "convergence.csv", cols, [[r[c] for r in rows] for c in cols],
-              text_columns={"scheme"})
+    write_csv(out / "convergence.csv", (*cols, "reason"),
+              [[r[c] for r in rows] for c in (*cols, "reason")],
+              text_columns={"scheme", "reason"})
     error_vs_runtime(rows, out / "error_vs_runtime.png", title=f"{scene.title or args.scene}")
     print("observed order in the grid size (successive grids; least-squares fit):")
     for key in studies.ERROR_KEYS:

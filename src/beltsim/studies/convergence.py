@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import solvers
+from ..errors import SceneError
 from ..physics.grid import bisect
 from ..problem.scene import Scene
 from ..simulation.controller import Simulation
@@ -62,39 +63,51 @@ def richardson(scene: Scene, reference=None):
 
 
 def _row(scheme, elements, h_min, dt, steps, newton_iterations, wall_time, compile_time,
-         converged, err):
+         converged, err, reason=""):
     err = err or {}
     return {"scheme": scheme, "elements": elements, "h_min": h_min, "dt": dt, "steps": steps,
             "newton_iterations": newton_iterations, "wall_time": wall_time,
             "compile_time": compile_time, "converged": converged,
             **{f"error_{k}": err[k] if err.get(k) is not None else float("nan")
-               for k in ERROR_KEYS}}
+               for k in ERROR_KEYS}, "reason": reason}
 
 
 def convergence(scene: Scene, ladder=LADDER, schemes=None, progress=None) -> list[dict]:
-    """Run each scheme on each grid of the ladder; one row per run."""
+    """Run each scheme on each grid of the ladder; one row per run.
+
+    A rung refused before running (a SceneError, e.g. the explicit scheme's
+    numerics.max_work on a fine grid) is a row that did not converge, with the refusal
+    as its reason: the rest of the ladder still runs and reports.
+    """
     rows = []
     reference = reference_of(scene)
+    nan = float("nan")
     for scheme in schemes or schemes_for(scene):
         for n in ladder:
             sc = scene.with_overrides([f"numerics.elements={n}"])
-            if scheme == RICHARDSON:
-                r1, r2, err, wall = richardson(sc, reference)
-                row = _row(scheme, n, r1.solution.grid.h_min, float("nan"), r1.steps + r2.steps,
-                           r1.newton_iterations + r2.newton_iterations, wall,
-                           r1.compile_time + r2.compile_time, err is not None, err)
-            else:
-                sim = Simulation(sc.with_overrides([f"numerics.integrator={scheme}"]))
-                res = sim.run(raise_on_failure=False)
-                res.reference = reference
-                dt = sim.numerics.dt if sim.scheme.transient else float("nan")
-                row = _row(scheme, n, sim.grid.h_min, dt, res.steps,
-                           res.newton_iterations, res.wall_time, res.compile_time,
-                           res.converged, res.errors())
+            try:
+                row = _rung(sc, scheme, n, reference)
+            except SceneError as exc:
+                row = _row(scheme, n, nan, nan, 0, 0, nan, nan, False, None, str(exc))
             rows.append(row)
             if progress:
                 progress(row)
     return rows
+
+
+def _rung(sc, scheme, n, reference) -> dict:
+    """One scheme on one grid of the ladder."""
+    if scheme == RICHARDSON:
+        r1, r2, err, wall = richardson(sc, reference)
+        return _row(scheme, n, r1.solution.grid.h_min, float("nan"), r1.steps + r2.steps,
+                    r1.newton_iterations + r2.newton_iterations, wall,
+                    r1.compile_time + r2.compile_time, err is not None, err)
+    sim = Simulation(sc.with_overrides([f"numerics.integrator={scheme}"]))
+    res = sim.run(raise_on_failure=False)
+    res.reference = reference
+    dt = sim.numerics.dt if sim.scheme.transient else float("nan")
+    return _row(scheme, n, sim.grid.h_min, dt, res.steps, res.newton_iterations,
+                res.wall_time, res.compile_time, res.converged, res.errors())
 
 
 def observed_orders(rows, key) -> dict:
