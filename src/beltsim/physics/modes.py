@@ -132,13 +132,14 @@ def steady_discretisation(scene, elements=None):
     over = ["numerics.integrator=steady"]
     if elements is not None:
         over.append(f"numerics.elements={elements}")
-    sim = Simulation(_without_transient_keys(scene).with_overrides(over))
+    sim = Simulation(steady_scene(scene).with_overrides(over))
     sim.run(raise_on_failure=True)
     return sim.disc, sim.state
 
 
-def _without_transient_keys(scene):
-    """The scene without the numerics keys the steady scheme refuses (time stepping)."""
+def steady_scene(scene):
+    """The scene without the numerics keys of time stepping (the steady scheme refuses
+    them; they change neither the grid nor the steady state)."""
     data = scene.to_dict()
     nm = data.get("numerics", {})
     for key in ("dt", "t_end", "time_tol", "max_work", "acceleration", "integrator"):

@@ -163,7 +163,9 @@ def stability_cell(case: Case, scheme: str, extra=()) -> dict:
 def steady_state_stability(scene) -> tuple[bool, str]:
     """(unstable, why): whether the scene's discrete steady state (its grid) is linearly
     unstable by a clear margin (GROWTH_MARGIN), and a sentence with the growth rate."""
-    key = scene.to_toml()
+    from ..physics.modes import steady_scene
+
+    key = steady_scene(scene).to_toml()  # the time-stepping keys do not change the verdict
     if key not in _VERDICTS:
         _VERDICTS[key] = _stability_verdict(scene)
     return _VERDICTS[key]
