@@ -181,3 +181,31 @@ def test_an_undamped_scene_still_ringing_at_t_end_counts_as_bounded():
     assert undamped["reason"].startswith("undamped, still ringing: not steady by t_end")
     damped = rs.random_cell(scene, 1, "implicit", extra=short)
     assert damped["status"] == CellStatus.NOT_CONVERGED.value and rs.failed(damped), damped
+
+
+def test_jobs_give_the_same_rows_in_the_same_order(monkeypatch):
+    """A pool of processes (--jobs) runs the same cells: rows, progress and on_failure in
+    scene order, whatever order the cells finish in; max_wall skips alike."""
+    import time
+
+    def fake(scene, i, scheme, extra):
+        time.sleep(0.02 * ((7 * i + len(scheme)) % 5))  # finish out of order
+        bad = i % 4 == 1 and scheme == "implicit"
+        return {"index": i, "scheme": scheme, "status": "diverged" if bad else "converged",
+                "reason": "x" if bad else "", "reason_key": "", **rs.describe(scene),
+                "elapsed": 0.0}
+    monkeypatch.setattr(rs, "random_cell", fake)
+    runs = {}
+    for jobs in (1, 3):
+        shown, failures = [], []
+        rows = rs.random_study(12, 5, jobs=jobs, progress=shown.append,
+                               on_failure=lambda s, r: failures.append(
+                                   (s.title, [x["scheme"] for x in r])))
+        runs[jobs] = (rows, shown, failures)
+    assert runs[1] == runs[3]
+    assert [(r["index"], r["scheme"]) for r in runs[3][1]] == [
+        (i, s) for i in range(12) for s in solvers.names() if s not in rs.DEFERRED] + [
+        (i, s) for i in range(12) for s in rs.DEFERRED]
+    assert len(runs[3][2]) == 3
+    skipped = rs.random_study(3, 5, jobs=2, max_wall=1e-9)
+    assert {r["status"] for r in skipped} == {rs.SKIPPED}

@@ -191,6 +191,8 @@ def _stability_random(args):
         raise UsageError(f"--random: must be >= 1 scene, got {args.random}")
     if args.max_wall is not None and not args.max_wall > 0:
         raise UsageError(f"--max-wall: must be > 0 s, got {args.max_wall}")
+    if args.jobs is not None and args.jobs < 1:
+        raise UsageError(f"--jobs: must be >= 1, got {args.jobs}")
     seed = 0 if args.seed is None else args.seed
     out = prepare_outdir(args.out or Path("runs/out/stability_random"))
     failures = out / "failures"
@@ -209,7 +211,7 @@ def _stability_random(args):
                      studies.failure_scene(scene, rows, extra).to_toml())
     start = time.perf_counter()
     rows = studies.random_study(args.random, seed, extra=extra, max_wall=args.max_wall,
-                                progress=show, on_failure=keep)
+                                progress=show, on_failure=keep, jobs=args.jobs or 1)
     wall = time.perf_counter() - start
     write_csv(out / "random.csv", studies.COLUMNS,
               [[r[c] for r in rows] for c in studies.COLUMNS],
@@ -240,8 +242,8 @@ def cmd_stability(args):
 
     if args.random is not None:
         return _stability_random(args)
-    if args.seed is not None or args.max_wall is not None:
-        raise UsageError("--seed and --max-wall go with --random N")
+    if args.seed is not None or args.max_wall is not None or args.jobs is not None:
+        raise UsageError("--seed, --max-wall and --jobs go with --random N")
     out = prepare_outdir(args.out or Path("runs/out/stability"))
     extra = [f"numerics.elements={args.elements}"] if args.elements else []
     cases = studies.STABILITY_CASES
@@ -470,6 +472,9 @@ def build_parser():
     p.add_argument("--max-wall", type=float, default=None, metavar="SECONDS",
                    help="with --random: start no cell after this many seconds (the rest "
                    "are reported as skipped)")
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="with --random: run the cells in N processes (default 1); the rows "
+                   "and counts are the same, only the wall times differ")
     p.set_defaults(func=cmd_stability)
 
     p = sub.add_parser("bench", help="paper slip scene: ours against generic scipy peers "

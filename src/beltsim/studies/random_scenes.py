@@ -42,6 +42,7 @@ from collections import Counter
 import numpy as np
 
 from .. import solvers
+from ..errors import BeltsimError
 from ..problem.scene import Scene
 from .convergence import ERROR_KEYS
 from .stability import ACCEPTED, BOUNDS, Case, CellStatus, stability_cell
@@ -154,7 +155,8 @@ def reason_key(status, reason: str) -> str:
         return m.group(1)
     if status == CellStatus.OUT_OF_BOUNDS.value:
         return ", ".join(part.split()[0] for part in reason.split("; "))
-    if status in (CellStatus.NOT_CONVERGED.value, CellStatus.DIVERGED.value, CRASHED):
+    if status in (CellStatus.NOT_CONVERGED.value, CellStatus.DIVERGED.value, CRASHED,
+                  CellStatus.UNSTABLE.value):
         words = re.sub(r"[-+]?\d[\d.e+-]*", "#", reason or "").split("(")[0]
         return words.strip()[:70]
     return ""
@@ -164,11 +166,42 @@ def failed(row) -> bool:
     return row["status"] not in ACCEPTED and row["status"] != SKIPPED
 
 
+#: An undamped inertial scene runs a time-accurate scheme for the drive's settle time plus
+#: this many transits L / c, not the default 400: only friction dissipates, and the long
+#: runs that cost most of a random study (up to 1000 s a cell) end ringing anyway. A run
+#: still ringing there is judged by the eigenvalues of its steady state (stability_cell):
+#: bounded if stable, "unstable steady state" if a mode grows.
+RINGING_TRANSITS = 50
+
+
+def ringing_span(scene: Scene, scheme: str, extra=()) -> list[str]:
+    """The overrides that shorten an undamped scene's time-accurate run (RINGING_TRANSITS),
+    with the explicit scheme's max_work scaled alike, so that it refuses the cells it
+    would refuse over the default span."""
+    from ..solvers.settings import DEFAULT_MAX_WORK, resolve
+
+    P = scene.params
+    if not (P.inertia and P.damping == 0.0 and solvers.get(scheme).time_accurate):
+        return []
+    try:
+        num = resolve(scene.with_overrides(list(extra)))
+    except BeltsimError:  # stability_cell refuses the scene with this error
+        return []
+    t_end = num.settle_time + RINGING_TRANSITS * P.L / P.c
+    if not t_end < num.t_end:
+        return []
+    out = [f"numerics.t_end={t_end!r}"]
+    if scheme == "explicit":
+        out.append(f"numerics.max_work={DEFAULT_MAX_WORK * t_end / num.t_end!r}")
+    return out
+
+
 def random_cell(scene: Scene, index: int, scheme: str, extra=()) -> dict:
     """One scene by one scheme, judged by the stability matrix's rules."""
     start = time.perf_counter()
     try:
-        cell = stability_cell(scene_case(scene), scheme, extra=extra)
+        cell = stability_cell(scene_case(scene), scheme,
+                              extra=[*extra, *ringing_span(scene, scheme, extra)])
     except Exception as exc:  # noqa: BLE001  a crash is a finding, the rest must still run
         cell = {"scheme": scheme, "status": CRASHED,
                 "reason": f"{type(exc).__name__}: {exc}".replace("\n", " "),
@@ -237,14 +270,18 @@ FIRST_PASS_SHARE = 0.5
 
 
 def random_study(n: int, seed: int, schemes=None, extra=(), max_wall=None, progress=None,
-                 on_failure=None) -> list[dict]:
+                 on_failure=None, jobs: int = 1) -> list[dict]:
     """Every drawn scene by every registered scheme, one row per cell in scene order.
 
     The schemes of DEFERRED run in a second pass over the scenes the first pass reached.
     Cells not started within max_wall seconds are `skipped`, and so are the cell under way
     and the rest after a Ctrl-C (reason INTERRUPTED), so that what ran is still reported.
     on_failure(scene, rows) is called at each failed cell with the scene's rows so far.
+    With jobs > 1 the cells run in a pool of that many processes (:func:`_parallel_study`):
+    the same cells, rows and callbacks in the same order, only the wall times differ.
     """
+    if jobs > 1:
+        return _parallel_study(n, seed, schemes, extra, max_wall, progress, on_failure, jobs)
     start, stop = time.perf_counter(), ""
     schemes = tuple(schemes or solvers.names())
     scenes = [draw_scene(seed, i) for i in range(n)]
@@ -279,6 +316,85 @@ def random_study(n: int, seed: int, schemes=None, extra=(), max_wall=None, progr
                     progress(row)
                 if on_failure and failed(row):
                     on_failure(scene, [done[i, s] for s in schemes if (i, s) in done])
+    return [done[i, s] for i in range(n) for s in schemes]
+
+
+def _skipped(scene, i, scheme, reason, extra) -> dict:
+    return {"index": i, "scheme": scheme, "status": SKIPPED, "reason": reason,
+            "reason_key": "", **describe(scene, extra), "dt": math.nan, "steps": 0,
+            "wall_time": math.nan, "elapsed": 0.0,
+            **{f"error_{k}": math.nan for k in ERROR_KEYS}}
+
+
+def _cell_task(seed, i, scheme, extra):
+    """One cell in a worker process (the scene is drawn there: only numbers travel)."""
+    return random_cell(draw_scene(seed, i), i, scheme, extra)
+
+
+def _parallel_study(n, seed, schemes, extra, max_wall, progress, on_failure, jobs):
+    """random_study on a pool of `jobs` processes, with its rules: cells are started in
+    scene order, at most `jobs` at a time, and none after the pass's share of max_wall
+    (the second pass runs on the scenes whose first cell the first pass started); rows,
+    progress and on_failure come in scene order, as each cell and all before it are done."""
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+    start = time.perf_counter()
+    schemes = tuple(schemes or solvers.names())
+    scenes = [draw_scene(seed, i) for i in range(n)]
+    first = [s for s in schemes if s not in DEFERRED]
+    second = [s for s in schemes if s in DEFERRED]
+    done: dict[tuple[int, str], dict] = {}
+    reached, interrupted = n, False
+    pool = ProcessPoolExecutor(max_workers=jobs)
+    try:
+        for group, share in ((first, FIRST_PASS_SHARE if second else 1.0), (second, 1.0)):
+            tasks = [(i, s) for i in range(n) for s in group]
+            running: dict = {}  # future -> task
+            results: dict[tuple[int, str], dict] = {}
+            k_next = k_emit = 0
+            stop = INTERRUPTED if interrupted else ""
+            while k_emit < len(tasks):
+                while k_next < len(tasks) and len(running) < jobs:
+                    i, scheme = tasks[k_next]
+                    spent = time.perf_counter() - start
+                    if max_wall is not None and spent > share * max_wall and not stop:
+                        stop = f"--max-wall {max_wall:g} s: {share * max_wall:g} s spent"
+                        if group is first:  # the second pass runs on the scenes begun
+                            reached = i if scheme == group[0] else i + 1
+                    if i >= reached and not stop:
+                        stop = f"--max-wall {max_wall:g} s: scene not reached by {first[0]} ..."
+                    if stop:
+                        results[i, scheme] = _skipped(scenes[i], i, scheme, stop, extra)
+                    else:
+                        fut = pool.submit(_cell_task, seed, i, scheme, tuple(extra))
+                        running[fut] = (i, scheme)
+                    k_next += 1
+                if running and tasks[k_emit] not in results:
+                    try:
+                        finished, _ = wait(running, return_when=FIRST_COMPLETED)
+                    except KeyboardInterrupt:
+                        interrupted, stop = True, INTERRUPTED
+                        finished = list(running)
+                    for fut in finished:
+                        i, scheme = running.pop(fut)
+                        try:
+                            if interrupted:
+                                raise KeyboardInterrupt
+                            results[i, scheme] = fut.result()
+                        except BaseException:  # noqa: BLE001  a worker stopped by the Ctrl-C
+                            interrupted, stop = True, INTERRUPTED
+                            results[i, scheme] = _skipped(scenes[i], i, scheme, INTERRUPTED,
+                                                          extra)
+                while k_emit < len(tasks) and tasks[k_emit] in results:
+                    i, scheme = tasks[k_emit]
+                    row = done[i, scheme] = results[i, scheme]
+                    k_emit += 1
+                    if progress:
+                        progress(row)
+                    if on_failure and failed(row):
+                        on_failure(scenes[i], [done[i, s] for s in schemes if (i, s) in done])
+    finally:
+        pool.shutdown(wait=not interrupted, cancel_futures=True)
     return [done[i, s] for i in range(n) for s in schemes]
 
 

@@ -32,11 +32,21 @@ class CellStatus(str, enum.Enum):
     DIVERGED = "diverged"
     REFUSED = "refused"
     NOT_APPLICABLE = "not applicable"
+    #: a time-accurate run diverged or did not settle, and the eigenvalues of the model
+    #: linearised about its steady state show a growing mode (physics.modes)
+    UNSTABLE = "unstable steady state"
 
 
-#: Statuses that count as a pass: the scheme either delivers or says why it cannot.
+#: Statuses that count as a pass: the scheme either delivers or says why it cannot (an
+#: unstable steady state is a reason the model itself gives, with its growth rate).
 ACCEPTED = (CellStatus.CONVERGED, CellStatus.BOUNDED, CellStatus.REFUSED,
-            CellStatus.NOT_APPLICABLE)
+            CellStatus.NOT_APPLICABLE, CellStatus.UNSTABLE)
+#: A growth rate counts as unstable above this fraction of max(|lambda|, c / L): growth
+#: of at least 1e-3 per radian of the mode's oscillation and per transit (far above
+#: the eigensolver's round-off, measured 1e-9 relative between dense and shift-invert).
+GROWTH_MARGIN = 1e-3
+#: Run failures that are divergence (the state grew), not a solver's failure to step.
+_DIVERGENCE = ("grew without bound", "non-finite")
 _RUN_STATUS = {RunStatus.FAILED: CellStatus.DIVERGED, RunStatus.REACHED_END:
                CellStatus.NOT_CONVERGED, RunStatus.INTERRUPTED: CellStatus.NOT_CONVERGED}
 
@@ -135,12 +145,48 @@ def stability_cell(case: Case, scheme: str, extra=()) -> dict:
                            f"{res.history['rate'][-1]:.3g}")
     elif not res.converged:
         cell.update(status=_RUN_STATUS[res.status], reason=res.reason)
+        diverged = (res.status is RunStatus.FAILED
+                    and any(d in (res.reason or "") for d in _DIVERGENCE))
+        if (sim.scheme.time_accurate and scene.params.inertia
+                and (diverged or res.status is RunStatus.REACHED_END)):
+            unstable, why = steady_state_stability(scene)
+            cell.update(status=CellStatus.UNSTABLE if unstable else cell["status"],
+                        reason=f"{why}; {res.reason}" if unstable else f"{res.reason}; {why}")
     else:
         over = [f"{k} {err[k]:.3g} > {b:g}" for k, b in BOUNDS.items()
                 if err.get(k) is not None and not err[k] <= b]
         cell.update(status=CellStatus.OUT_OF_BOUNDS if over else CellStatus.CONVERGED,
                     reason="; ".join(over))
     return cell
+
+
+def steady_state_stability(scene) -> tuple[bool, str]:
+    """(unstable, why): whether the scene's discrete steady state (its grid) is linearly
+    unstable by a clear margin (GROWTH_MARGIN), and a sentence with the growth rate."""
+    from ..physics.modes import steady_scene
+
+    key = steady_scene(scene).to_toml()  # the time-stepping keys do not change the verdict
+    if key not in _VERDICTS:
+        _VERDICTS[key] = _stability_verdict(scene)
+    return _VERDICTS[key]
+
+
+_VERDICTS: dict[str, tuple[bool, str]] = {}  # per scene: implicit and explicit share it
+
+
+def _stability_verdict(scene) -> tuple[bool, str]:
+    from ..physics.modes import growth_rate
+
+    try:
+        g = growth_rate(scene)
+    except Exception as exc:  # noqa: BLE001  no verdict leaves the cell as it was
+        return False, f"no linear stability verdict ({type(exc).__name__}: {exc})"
+    P = scene.params
+    margin = GROWTH_MARGIN * max(math.hypot(g.rate, 2 * math.pi * g.frequency), P.c / P.L)
+    if g.rate > margin:
+        return True, (f"the steady state is linearly unstable: {g.describe()} on this grid "
+                      f"({g.elements} elements), so no run can settle: the model flutters")
+    return False, (f"the steady state is linearly stable on this grid: {g.describe()}")
 
 
 def stability_matrix(cases=STABILITY_CASES, schemes=None, extra=(), progress=None):

@@ -1,0 +1,191 @@
+"""Linear stability of the discrete steady state: the eigenvalue with the largest real part.
+
+The residual kernel :func:`beltsim.physics.model.assemble` is written for backward Euler
+with ``inv_dt`` = s. With the old state equal to the steady state y0 and zero rates, its
+Jacobian at y0 is exactly the matrix polynomial of the semi-discrete model linearised
+about y0::
+
+    P(s) = M s^2 + C s + K,   M = diag(rho hbar_j, I hbar_j) (lumped),
+
+so K = P(0) and C = (P(s0) - P(-s0)) / (2 s0) (exact for a quadratic; s0 is taken as
+sqrt(max K_ii / max M_ii), the grid's highest frequency, so that the three terms are of
+one size and nothing cancels). The friction enters through its slope at the steady slip
+velocities (the primal-dual form's condensed Jacobian is the same at a converged state).
+A perturbation y = y0 + z e^{lambda t} solves P(lambda) z = 0; the eigenvalues lambda
+are those of the companion matrix [[0, 1], [-M^-1 K, -M^-1 C]] (4 (N - 1) of them).
+
+How the largest real part is found (:func:`growth_rate`):
+
+* grids up to DENSE_ELEMENTS elements: every eigenvalue, dense (LAPACK; 27 s at 1000
+  elements, 0.3 s at 200, measured on one core);
+* finer grids: the dense spectrum of the same scene on DENSE_ELEMENTS elements gives the
+  candidate mode, then ARPACK in shift-invert mode finds the NEAREST eigenvalues of the
+  fine grid around it. This can miss a mode that is unstable on the fine grid only (the
+  coarse grid's upwind gyroscopic term damps more: on the outlet case +4.3 1/s at 1000
+  elements, +16.3 converged), so it errs towards "stable", never towards "unstable" on
+  a grid where no unstable mode exists: an unstable eigenvalue it reports is one of the
+  fine grid's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .model import Loads, State, assemble, model_params
+
+#: Up to this many elements the spectrum is computed whole (dense); above, see above.
+DENSE_ELEMENTS = 500
+#: Eigenvalues ARPACK finds around each candidate on a fine grid, and the candidates:
+#: the coarse grid's least stable modes.
+NEAREST = 12
+CANDIDATES = 4
+
+
+@dataclass(frozen=True)
+class Growth:
+    """The eigenvalue with the largest real part of a linearised steady state."""
+
+    rate: float  # Re lambda (1/s): > 0 grows
+    frequency: float  # |Im lambda| / (2 pi) (Hz)
+    elements: int  # of the grid the eigenvalue belongs to
+    method: str  # "dense", or "shift-invert near the N-element mode"
+    coarse: "Growth | None" = None  # the coarse grid's, when the method is shift-invert
+
+    def describe(self) -> str:
+        return (f"a mode at {self.frequency:.4g} Hz grows at {self.rate:.3g} 1/s"
+                if self.rate > 0 else
+                f"its least stable mode ({self.frequency:.4g} Hz) decays at "
+                f"{-self.rate:.3g} 1/s")
+
+
+def blocks_to_sparse(Lb, Db, Ub, L2):
+    """CSR matrix of a block-banded Jacobian (2x2 blocks; L2 the second lower band)."""
+    n = Db.shape[0]
+    rows, cols, vals = [], [], []
+    for blocks, off in ((Db, 0), (Lb, -1), (L2, -2), (Ub, 1)):
+        i = np.arange(max(0, -off), min(n, n - off))
+        for a in range(2):
+            for b in range(2):
+                rows.append(2 * i + a)
+                cols.append(2 * (i + off) + b)
+                vals.append(blocks[i, a, b])
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(2 * n, 2 * n))
+
+
+def jacobian(disc, state: State, s: float):
+    """P(s) of the discretisation `disc` linearised about the steady `state` (sparse)."""
+    from ..problem.drive import Drive
+    from ..solvers.newton import Workspace
+
+    P, num = disc.params, disc.numerics
+    # the scene's own damping: numerics.acceleration belongs to the pseudo scheme's path
+    p = model_params(P, P.damping, num.fs, num.vreg, num.law_code)
+    N = disc.grid.n_elements
+    w = Workspace.allocate(N)
+    old = State(state.u.copy(), state.theta.copy(), state.lam.copy(), np.zeros(N + 1),
+                np.zeros(N + 1), np.zeros(N + 1))
+    lam = state.lam.copy()
+    fnode = np.zeros(N + 1)
+    assemble(state.u.copy(), state.theta.copy(), lam, fnode, old, s, 0.0, disc.mesh, p,
+             Drive.constant(P.v - P.c), Loads.none(N + 1), w, True)
+    return blocks_to_sparse(w.Lb, w.Db, w.Ub, w.L2)
+
+
+def linearisation(disc, state: State):
+    """(M, C, K) of the semi-discrete model about the steady `state` (sparse; M diagonal)."""
+    P = disc.params
+    hb = disc.grid.hbar[1:-1]
+    m = np.column_stack([P.rho * hb, P.I * hb]).ravel()
+    K = jacobian(disc, state, 0.0)
+    s0 = math.sqrt(np.abs(K.diagonal()).max() / m.max())
+    C = (jacobian(disc, state, s0) - jacobian(disc, state, -s0)) / (2.0 * s0)
+    return sp.diags(m).tocsr(), C.tocsr(), K
+
+
+def companion(M, C, K):
+    """The first-order system matrix [[0, 1], [-M^-1 K, -M^-1 C]] (sparse)."""
+    n = K.shape[0]
+    minv = sp.diags(1.0 / M.diagonal())
+    return sp.bmat([[None, sp.identity(n)], [-minv @ K, -minv @ C]], format="csc")
+
+
+def _largest(eigs) -> complex:
+    return complex(eigs[np.argmax(eigs.real)])
+
+
+def _growth(lam, elements, method, coarse=None) -> Growth:
+    return Growth(lam.real, abs(lam.imag) / (2.0 * math.pi), elements, method, coarse)
+
+
+def steady_discretisation(scene, elements=None):
+    """The scene's steady state by the steady scheme on its grid (or on `elements`):
+    (Discretisation, State). Raises NumericalError when the steady solve fails."""
+    from ..simulation.controller import Simulation
+
+    over = ["numerics.integrator=steady"]
+    if elements is not None:
+        over.append(f"numerics.elements={elements}")
+    sim = Simulation(steady_scene(scene).with_overrides(over))
+    sim.run(raise_on_failure=True)
+    return sim.disc, sim.state
+
+
+def steady_scene(scene):
+    """The scene without the numerics keys of time stepping (the steady scheme refuses
+    them; they change neither the grid nor the steady state)."""
+    data = scene.to_dict()
+    nm = data.get("numerics", {})
+    for key in ("dt", "t_end", "time_tol", "max_work", "acceleration", "integrator"):
+        nm.pop(key, None)
+    return type(scene).from_dict(data)
+
+
+def spectrum(disc, state) -> np.ndarray:
+    """Every eigenvalue of the linearisation (dense; small grids)."""
+    A = companion(*linearisation(disc, state)).toarray()
+    return scipy.linalg.eigvals(A, overwrite_a=True, check_finite=False)
+
+
+def growth_rate(scene, dense_elements=DENSE_ELEMENTS) -> Growth:
+    """The largest real part of the eigenvalues of the scene's discrete model (its own
+    grid, numerics.elements or the default) linearised about its steady state.
+
+    Raises NumericalError when the steady state cannot be solved for, ValueError for a
+    quasistatic scene (no dynamics)."""
+    if not scene.params.inertia:
+        raise ValueError("a quasistatic scene has no dynamics to linearise")
+    disc, state = steady_discretisation(scene)
+    N = disc.grid.n_elements
+    if N <= dense_elements:
+        return _growth(_largest(spectrum(disc, state)), N, "dense")
+    cdisc, cstate = steady_discretisation(scene, dense_elements)
+    eigs = spectrum(cdisc, cstate)
+    coarse = _growth(_largest(eigs), dense_elements, "dense")
+    A = companion(*linearisation(disc, state)).astype(complex)
+    found = []
+    for sigma in _candidates(eigs, CANDIDATES):
+        found.append(spla.eigs(A, k=NEAREST, sigma=sigma, which="LM",
+                               return_eigenvectors=False, tol=1e-10, maxiter=5000))
+    return _growth(_largest(np.concatenate(found)), N,
+                   f"shift-invert near the {dense_elements}-element grid's least stable "
+                   f"modes", coarse)
+
+
+def _candidates(eigs, k):
+    """The k least stable eigenvalues of distinct frequency (upper half plane)."""
+    out = []
+    for lam in eigs[np.argsort(-eigs.real)]:
+        if lam.imag < 0.0:
+            continue
+        if all(abs(lam - o) > 1e-6 * (1.0 + abs(o)) for o in out):
+            out.append(complex(lam))
+        if len(out) == k:
+            break
+    return out

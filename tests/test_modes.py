@@ -1,0 +1,133 @@
+"""Linear stability of the steady state (physics.modes) and the cells it classifies."""
+
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from beltsim.physics import modes
+from beltsim.physics.model import State, residual_numpy
+from beltsim.problem.drive import Drive
+from beltsim.problem.scene import load_scene, runs_dir
+from beltsim.simulation import trackers
+from beltsim.studies import random_scenes as rs
+from beltsim.studies import stability
+from beltsim.studies.stability import ACCEPTED, Case, CellStatus, stability_cell
+
+
+def _slip(n, *over):
+    return load_scene(runs_dir() / "paper_slip.toml", [f"numerics.elements={n}", *over])
+
+
+def _flutter(n):
+    """Random scene 191 of seed 1 (stick, undamped, 0.77 of the critical speed): its
+    steady state is unstable from about 300 elements on (+0.27 1/s at 3.9 Hz on 1000)."""
+    return rs.draw_scene(1, 191).with_overrides([f"numerics.elements={n}"])
+
+
+@pytest.mark.parametrize("c", [0.3, 5.0, -0.3])
+def test_the_companion_matrix_has_the_oscillators_eigenvalues(c):
+    """m x'' + c x' + k x = 0: lambda = (-c +- sqrt(c^2 - 4 m k)) / (2 m), and a negative
+    damping grows; two uncoupled oscillators give both pairs."""
+    m, k = np.array([2.0, 0.5]), np.array([3.0, 7.0])
+    A = modes.companion(sp.diags(m), sp.diags([c, 1.0]), sp.diags(k)).toarray()
+    got = np.sort_complex(np.linalg.eigvals(A))
+    want = []
+    for mi, ci, ki in zip(m, (c, 1.0), k):
+        root = np.sqrt(complex(ci * ci - 4 * mi * ki))
+        want += [(-ci + root) / (2 * mi), (-ci - root) / (2 * mi)]
+    for w in want:  # each once (sorting is fragile where real parts tie)
+        assert np.min(np.abs(got - w)) < 1e-12 * (1 + abs(w)), (got, want)
+    assert len(got) == len(want)
+    assert (max(got.real) > 0) == (c < 0)
+
+
+@pytest.mark.parametrize("scene", [_slip(40), _flutter(40)], ids=["coulomb", "stick"])
+def test_the_linearisation_is_the_numpy_twins_derivative(scene):
+    """P(s) from the kernel equals the central difference of the numpy twin
+    residual_numpy (old state: the steady state at rest) at s = 0 and s != 0, and is
+    quadratic in s with the lumped masses: M = (P(s) + P(-s) - 2 P(0)) / (2 s^2)."""
+    disc, st = modes.steady_discretisation(scene)
+    P = disc.params
+    p = disc.model._replace(damping=P.damping)
+    N = disc.grid.n_elements
+    old = State(st.u, st.theta, st.lam, np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1))
+    drive = Drive.constant(P.v - P.c)
+    # a step small against the regularisation (the friction's slope changes over v_reg)
+    step = 1e-4 * disc.numerics.vreg * disc.grid.he.min() / P.c
+    M, C, K = modes.linearisation(disc, st)
+    s1 = 50.0
+    for s in (0.0, s1):
+        fd = np.zeros((2 * (N - 1), 2 * (N - 1)))
+        for col in range(2 * (N - 1)):
+            j, field = col // 2 + 1, col % 2
+            res = []
+            for sign in (1.0, -1.0):
+                u, th = st.u.copy(), st.theta.copy()
+                (u if field == 0 else th)[j] += sign * step
+                res.append(residual_numpy(u, th, old, s, 0.0, disc.mesh, p, drive)[0].ravel())
+            fd[:, col] = (res[0] - res[1]) / (2 * step)
+        kernel = modes.jacobian(disc, st, s).toarray()
+        scale = np.abs(kernel).max()
+        assert np.abs(fd - kernel).max() < 1e-6 * scale, (s, np.abs(fd - kernel).max() / scale)
+        assert np.abs((M * s * s + C * s + K).toarray() - kernel).max() < 1e-9 * scale
+    Pp, Pm = modes.jacobian(disc, st, s1), modes.jacobian(disc, st, -s1)
+    np.testing.assert_allclose(((Pp + Pm - 2 * K) / (2 * s1**2)).toarray(), M.toarray(),
+                               rtol=1e-6, atol=1e-13 * abs(Pp).max() / s1**2)  # round-off
+
+
+def test_growth_rate_signs_and_the_fine_grid_search():
+    """Paper slip (damped, 200 elements): every mode decays; scene 191 (400 elements): a
+    3.9 Hz mode grows. On a grid above dense_elements the shift-invert search around the
+    coarse grid's least stable modes finds the dense spectrum's largest real part."""
+    stable = modes.growth_rate(_slip(200))
+    assert stable.rate < -5.0 and stable.method == "dense"
+    dense = modes.growth_rate(_flutter(400))
+    assert dense.method == "dense" and 0.05 < dense.rate < 0.2
+    assert dense.frequency == pytest.approx(3.88, abs=0.01)
+    search = modes.growth_rate(_flutter(400), dense_elements=100)
+    assert search.method.startswith("shift-invert") and search.elements == 400
+    assert search.coarse.rate < 0  # stable on 100 elements: found on the fine grid
+    assert search.rate == pytest.approx(dense.rate, rel=1e-6)
+    assert search.frequency == pytest.approx(dense.frequency, rel=1e-7)
+
+
+def test_a_diverged_cell_is_accepted_only_when_its_steady_state_is_unstable(monkeypatch):
+    """Any growth counts as divergence here (GROWTH_LIMIT ~ 0): the unstable scene's cell
+    becomes "unstable steady state" with its growth rate; the stable one stays diverged,
+    a failure, with the stable verdict in its reason."""
+    monkeypatch.setattr(trackers, "GROWTH_LIMIT", 1e-12)
+    monkeypatch.setattr(stability, "_VERDICTS", {})
+    unstable = stability_cell(rs.scene_case(rs.draw_scene(1, 191)), "implicit",
+                              extra=["numerics.elements=400"])
+    assert unstable["status"] is CellStatus.UNSTABLE and unstable["status"] in ACCEPTED
+    assert "linearly unstable: a mode at 3.877 Hz grows at 0.107 1/s" in unstable["reason"]
+    assert "grew without bound" in unstable["reason"]
+    stable = stability_cell(Case("slip", "paper_slip"), "implicit",
+                            extra=["numerics.elements=200"])
+    assert stable["status"] is CellStatus.DIVERGED and stable["status"] not in ACCEPTED
+    assert "grew without bound" in stable["reason"] and "linearly stable" in stable["reason"]
+
+
+def test_an_undamped_scene_runs_a_shorter_span_and_is_judged_by_its_modes():
+    """The random study stops an undamped time-accurate run at RINGING_TRANSITS transits
+    (the explicit scheme's max_work scaled alike); one still ringing there is bounded when
+    its steady state is stable and "unstable steady state" when it is not."""
+    scene = rs.draw_scene(1, 191)
+    P = scene.params
+    over = dict(o.split("=") for o in rs.ringing_span(scene, "explicit"))
+    t_end = float(over["numerics.t_end"])
+    assert t_end == pytest.approx(2 * P.L / P.c + rs.RINGING_TRANSITS * P.L / P.c)
+    assert float(over["numerics.max_work"]) == pytest.approx(
+        2e10 * t_end / (2 * P.L / P.c + 400 * P.L / P.c))
+    assert rs.ringing_span(scene, "pseudo") == rs.ringing_span(scene, "steady") == []
+    damped = _slip(100)
+    assert rs.ringing_span(damped, "implicit") == []
+    short = ["numerics.elements=400", "numerics.t_end=1.0"]
+    cell = rs.random_cell(scene, 191, "implicit", extra=short)
+    assert cell["status"] == CellStatus.UNSTABLE.value and not rs.failed(cell), cell
+    assert cell["reason_key"].startswith("the steady state is linearly unstable")
+    ringing = rs.random_cell(_slip(120, "physics.damping=0"), 0, "implicit",
+                             extra=["numerics.t_end=0.02"])
+    assert ringing["status"] == CellStatus.BOUNDED.value
+    assert "linearly stable" in ringing["reason"]
