@@ -348,6 +348,18 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
 
 
 @njit(cache=True)
+def add_stick_penalty(w, inv_dt, fs, mesh, p):
+    """After an exact law's assembly: the stuck nodes' constraint v_rel = 0 as the slope
+    f_s AUGMENTATION / v_aug (the default regularisation's) in the 2x2 Jacobian blocks,
+    w.sg scaled to match. The 2x2 stand-in of the semi-smooth Newton's 3x3 system, for
+    what needs a 2x2 Jacobian: the implicit scheme's error filter, the linearisation."""
+    for j in range(mesh.c0, mesh.j2 + 1):
+        w.sg[j] *= AUGMENTATION
+        add_friction_slope(w, j - 1, j, mesh.wf[j] * fs * w.sg[j] / p.v_reg, inv_dt,
+                           p.speed, p.half_height, mesh.sw)
+
+
+@njit(cache=True)
 def add_friction_slope(w, i, j, k, inv_dt, c, hh, sw):
     """Add to row block i the Jacobian of a nodal force -k v_rel,j (k = -dF_j/dv_rel)."""
     for o in range(4):

@@ -37,7 +37,8 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .model import Loads, State, assemble, model_params
+from .friction import is_exact
+from .model import Loads, State, add_stick_penalty, assemble, model_params
 
 #: Up to this many elements the spectrum is computed whole (dense); above, see above.
 DENSE_ELEMENTS = 500
@@ -95,6 +96,8 @@ def jacobian(disc, state: State, s: float):
     fnode = np.zeros(N + 1)
     assemble(state.u.copy(), state.theta.copy(), lam, fnode, old, s, 0.0, disc.mesh, p,
              Drive.constant(P.v - P.c), Loads.none(N + 1), w, True)
+    if is_exact(p.law):  # the stuck nodes' constraint, as the semi-smooth Newton's stand-in
+        add_stick_penalty(w, s, p.friction_scale, disc.mesh, p)
     return blocks_to_sparse(w.Lb, w.Db, w.Ub, w.L2)
 
 

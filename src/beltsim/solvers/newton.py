@@ -17,8 +17,8 @@ import numpy as np
 from numba import njit
 
 from ..errors import NumericalError
-from ..physics.friction import AUGMENTATION, EXACT, is_exact, law, law_inverse
-from ..physics.model import add_friction_slope, assemble, update_multipliers
+from ..physics.friction import EXACT, is_exact, law, law_inverse
+from ..physics.model import add_stick_penalty, assemble, update_multipliers
 from ..problem.drive import friction_factor
 from .base import Scheme
 from .ssn import Saddle, project, saddle_factor, saddle_substitute, saddle_system
@@ -357,10 +357,7 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
         if changed == 0 and (update < tol
                              or (update < ROUNDOFF_FLOOR * tol and rate > 0.5)
                              or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol)):
-            for j in range(mesh.c0, mesh.j2 + 1):
-                w.sg[j] *= AUGMENTATION  # the default regularisation's slope in stick
-                add_friction_slope(w, j - 1, j, mesh.wf[j] * fs * w.sg[j] / p.v_reg, inv_dt,
-                                   p.speed, p.half_height, mesh.sw)
+            add_stick_penalty(w, inv_dt, fs, mesh, p)
             return factorise(w, mesh)
     st.merit = merit(w.R, scales)
     return False
