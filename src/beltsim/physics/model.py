@@ -359,23 +359,32 @@ def add_stick_penalty(w, inv_dt, fs, mesh, p):
                            p.speed, p.half_height, mesh.sw)
 
 
+@njit(cache=True, inline="always")
+def slip_velocity_slope(sw, j, o, c, inv_dt):
+    """d v_rel,j / d u_b at node j - 2 + o (o = 0..3): transport, and inv_dt at j itself."""
+    return c * sw[j, o] + (inv_dt if o == 2 else 0.0)
+
+
+@njit(cache=True, inline="always")
+def stencil_band(o, L2, Lb, Db, Ub):
+    """The Jacobian block band of row j's column j - 2 + o."""
+    if o == 0:
+        return L2
+    if o == 1:
+        return Lb
+    if o == 2:
+        return Db
+    return Ub
+
+
 @njit(cache=True)
 def add_friction_slope(w, i, j, k, inv_dt, c, hh, sw):
     """Add to row block i the Jacobian of a nodal force -k v_rel,j (k = -dF_j/dv_rel)."""
     for o in range(4):
-        dd = k * c * sw[j, o]
-        if o == 2:
-            dd += k * inv_dt
+        dd = k * slip_velocity_slope(sw, j, o, c, inv_dt)
         if dd == 0.0:
             continue
-        if o == 0:
-            blk = w.L2
-        elif o == 1:
-            blk = w.Lb
-        elif o == 2:
-            blk = w.Db
-        else:
-            blk = w.Ub
+        blk = stencil_band(o, w.L2, w.Lb, w.Db, w.Ub)
         blk[i, 0, 0] += dd
         blk[i, 0, 1] += dd * hh
         blk[i, 1, 0] += dd * hh
@@ -399,10 +408,8 @@ def update_multipliers(lam, dx, inv_dt, mesh, p, w):
         for o in range(4):
             k = j - 2 + o
             if 1 <= k <= n:
-                dub = dx[k - 1, 0] + hh * dx[k - 1, 1]
-                dvrel += c * sw[j, o] * dub
-                if o == 2:
-                    dvrel += inv_dt * dub
+                dvrel += (slip_velocity_slope(sw, j, o, c, inv_dt)
+                          * (dx[k - 1, 0] + hh * dx[k - 1, 1]))
         dl = sg[j] * (rl[j] + dvrel / vreg)
         if lam[j] + dl >= 1.0:
             dl = 0.99 * (1.0 - lam[j])

@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit
 
 from ..physics.friction import EXACT
+from ..physics.model import slip_velocity_slope, stencil_band
 
 
 class Saddle(NamedTuple):
@@ -101,19 +102,10 @@ def saddle_system(lam, inv_dt, fs, mesh, p, w, s):
             q = j - 2 + o
             if q < 1 or q > n:
                 continue
-            dd = c * mesh.sw[j, o] / vaug
-            if o == 2:
-                dd += inv_dt / vaug
+            dd = slip_velocity_slope(mesh.sw, j, o, c, inv_dt) / vaug
             if dd == 0.0:
                 continue
-            if o == 0:
-                blk = s.L2
-            elif o == 1:
-                blk = s.Lb
-            elif o == 2:
-                blk = s.Db
-            else:
-                blk = s.Ub
+            blk = stencil_band(o, s.L2, s.Lb, s.Db, s.Ub)
             blk[i, 2, 0] += dd
             blk[i, 2, 1] += dd * hh
     return changed
