@@ -37,7 +37,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..physics.friction import ADHESION, EXACT
+from ..physics.friction import EXACT
 from ..physics.model import LAM_MAX, POWER_TERMS, power_terms
 from ..problem.drive import friction_factor
 from .newton import FAILED, NONFINITE, OK, NewtonScheme, block_substitute, newton
@@ -97,13 +97,15 @@ def filtered_error(e, a0, fs, mesh, p, w, out):
 def predict_friction(lam, lam_prev, r, mesh, code):
     """Extrapolate the friction ratios lam (at t_n, in place) linearly to t_n + r (t_n - t_{n-1}).
 
-    Kept inside the bounds of the primal-dual iteration (+-LAM_MAX; +-1 for exact
-    Coulomb, none for exact adhesion): a node that
+    Kept inside the bounds of the primal-dual iteration (+-LAM_MAX): a node that
     reaches slip in the step starts there, and one that the extrapolation takes to
     the bound wrongly is caught by Newton's check of the ratios at the bound
-    (:func:`beltsim.solvers.newton.release_stuck_ratios`).
+    (:func:`beltsim.solvers.newton.release_stuck_ratios`). The exact laws take the
+    extrapolation as it is: a Coulomb ratio beyond +-1 starts the semi-smooth Newton
+    with the node sliding (its first update puts it on the bound); on random scene 6
+    of seed 1 (11,558 elements, to 0.2 s) 22,515 Newton iterations instead of 24,461.
     """
-    bound = math.inf if code == ADHESION else (1.0 if code == EXACT else LAM_MAX)
+    bound = math.inf if code >= EXACT else LAM_MAX
     for j in range(mesh.c0, mesh.j2 + 1):
         lam[j] = min(bound, max(-bound, lam[j] + r * (lam[j] - lam_prev[j])))
 
