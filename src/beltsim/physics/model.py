@@ -39,8 +39,17 @@ import numpy as np
 from numba import njit
 
 from ..problem.drive import friction_factor, mismatch
-from .friction import (ADHESION, AUGMENTATION, EXACT, LINEAR, TANH, has_dual, law, law_inverse,
-                       law_numpy)
+from .friction import (
+    ADHESION,
+    AUGMENTATION,
+    EXACT,
+    LINEAR,
+    TANH,
+    has_dual,
+    law,
+    law_inverse,
+    law_numpy,
+)
 
 # |lam| bound in the primal-dual iteration: the friction of a fully sliding node is
 # then f* (1 - 1e-14), and g^{-1} stays finite
