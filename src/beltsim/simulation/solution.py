@@ -134,8 +134,8 @@ class DiscreteSolution:
         j = g.j2
         if not sl[j]:
             return float(g.x[j]), None
-        while j > self.c0 and sl[j - 1]:
-            j -= 1
+        stuck = np.flatnonzero(~sl[self.c0:j])  # the sliding run ending at x2 starts after
+        j = self.c0 + stuck[-1] + 1 if len(stuck) else self.c0
         if j == self.c0:
             return float(g.x[g.j1]), None
         # the partly stuck node is j - 1, or j itself when x* lies at the very start of
