@@ -314,6 +314,11 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
 
     Full steps; converged when the update passes :func:`newton`'s tests and the
     stick/slip state of every friction node is the one the last step was solved with.
+    The ratios are not projected onto [-1, 1] between iterations: a stuck node whose
+    update overshoots the bound must count as sliding at the next assembly, and clipped
+    to the bound it sat on the switch (lam + v_rel / v_aug = +-1 with v_rel ~ 0) and was
+    read as stuck or sliding by round-off (random scene 6 of seed 1, 11,558 elements, to
+    0.2 s: 11,839 Newton iterations and 181 steps cut, against 22,515 and 394).
     On return, w holds the block LU of the 2x2 Jacobian with the stuck nodes' slope
     f_s AUGMENTATION / v_aug, the default regularisation's (a penalty standing in for
     their constraint), for the step's error estimate, as :func:`newton` leaves its own.
@@ -348,7 +353,6 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
             th[i + 1] += s.dx[i, 1]
         for j in range(mesh.c0, mesh.j2 + 1):
             lam[j] += s.dx[j - 1, 2]
-        project(lam, mesh, p.law)
         assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
         changed = saddle_system(lam, inv_dt, fs, mesh, p, w, s)
         update = max(step, dlam)
@@ -357,6 +361,7 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
         if changed == 0 and (update < tol
                              or (update < ROUNDOFF_FLOOR * tol and rate > 0.5)
                              or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol)):
+            project(lam, mesh, p.law)  # the sliding ratios, off +-1 by round-off
             add_stick_penalty(w, inv_dt, fs, mesh, p)
             return factorise(w, mesh)
     st.merit = merit(w.R, scales)
