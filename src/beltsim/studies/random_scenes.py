@@ -294,29 +294,35 @@ def random_study(n: int, seed: int, schemes=None, extra=(), max_wall=None, progr
             stop = ""
         for i, scene in enumerate(scenes):
             for scheme in group:
-                spent = time.perf_counter() - start
-                if max_wall is not None and spent > share * max_wall and not stop:
-                    stop = f"--max-wall {max_wall:g} s: {share * max_wall:g} s spent"
-                    if group is first:  # the second pass runs on the scenes begun
-                        reached = i if scheme == group[0] else i + 1
-                if i >= reached and not stop:
-                    stop = f"--max-wall {max_wall:g} s: scene not reached by {first[0]} ..."
+                stop, reached = _wall_stop(stop, reached, start, max_wall, share, group,
+                                           first, i, scheme)
                 if not stop:
                     try:
                         row = random_cell(scene, i, scheme, extra)
                     except KeyboardInterrupt:
                         stop = INTERRUPTED
                 if stop:
-                    row = {"index": i, "scheme": scheme, "status": SKIPPED, "reason": stop,
-                           "reason_key": "", **describe(scene, extra), "dt": math.nan,
-                           "steps": 0, "wall_time": math.nan, "elapsed": 0.0,
-                           **{f"error_{k}": math.nan for k in ERROR_KEYS}}
+                    row = _skipped(scene, i, scheme, stop, extra)
                 done[i, scheme] = row
                 if progress:
                     progress(row)
                 if on_failure and failed(row):
                     on_failure(scene, [done[i, s] for s in schemes if (i, s) in done])
     return [done[i, s] for i in range(n) for s in schemes]
+
+
+def _wall_stop(stop, reached, start, max_wall, share, group, first, i, scheme):
+    """(stop, reached) before cell (i, scheme) of a pass: the pass's share of max_wall
+    spent, or the scene not reached by the first pass (the second runs on the scenes
+    the first began)."""
+    spent = time.perf_counter() - start
+    if max_wall is not None and spent > share * max_wall and not stop:
+        stop = f"--max-wall {max_wall:g} s: {share * max_wall:g} s spent"
+        if group is first:
+            reached = i if scheme == group[0] else i + 1
+    if i >= reached and not stop:
+        stop = f"--max-wall {max_wall:g} s: scene not reached by {first[0]} ..."
+    return stop, reached
 
 
 def _skipped(scene, i, scheme, reason, extra) -> dict:
@@ -356,13 +362,8 @@ def _parallel_study(n, seed, schemes, extra, max_wall, progress, on_failure, job
             while k_emit < len(tasks):
                 while k_next < len(tasks) and len(running) < jobs:
                     i, scheme = tasks[k_next]
-                    spent = time.perf_counter() - start
-                    if max_wall is not None and spent > share * max_wall and not stop:
-                        stop = f"--max-wall {max_wall:g} s: {share * max_wall:g} s spent"
-                        if group is first:  # the second pass runs on the scenes begun
-                            reached = i if scheme == group[0] else i + 1
-                    if i >= reached and not stop:
-                        stop = f"--max-wall {max_wall:g} s: scene not reached by {first[0]} ..."
+                    stop, reached = _wall_stop(stop, reached, start, max_wall, share, group,
+                                               first, i, scheme)
                     if stop:
                         results[i, scheme] = _skipped(scenes[i], i, scheme, stop, extra)
                     else:
