@@ -143,3 +143,18 @@ def test_the_exact_law_linearises_like_its_regularised_twin():
     assert reg.rate < 0.0
     assert abs(exact.rate - reg.rate) < 1e-3 * abs(reg.rate)
     assert abs(exact.frequency - reg.frequency) < 1e-3 * reg.frequency
+
+
+def test_a_damped_run_cut_short_is_bounded_only_when_its_modes_are_too_slow(monkeypatch):
+    """Damped paper slip on 120 elements, stopped 0.033 s after the ramp: its least stable
+    mode decays at about 20 1/s (test above: -19.3 on 200 elements), so settling to 1e-6
+    needs ln(1e6) / 20 ~ 0.7 s: bounded, "stable but slow". With a verdict whose decay
+    would have settled it in time (injected), the same cell stays a failure."""
+    case = Case("slip", "paper_slip", ("numerics.elements=120", "numerics.t_end=0.05"))
+    monkeypatch.setattr(stability, "_VERDICTS", {})
+    slow = stability_cell(case, "implicit")
+    assert slow["status"] is CellStatus.BOUNDED, slow
+    assert slow["reason"].startswith("stable but slow: settling to steady_tol 1e-06 takes")
+    fast = {k: (False, "injected", 1e6) for k in stability._VERDICTS}
+    monkeypatch.setattr(stability, "_VERDICTS", fast)
+    assert stability_cell(case, "implicit")["status"] is CellStatus.NOT_CONVERGED

@@ -149,9 +149,20 @@ def stability_cell(case: Case, scheme: str, extra=()) -> dict:
                     and any(d in (res.reason or "") for d in _DIVERGENCE))
         if (sim.scheme.time_accurate and scene.params.inertia
                 and (diverged or res.status is RunStatus.REACHED_END)):
-            unstable, why = steady_state_stability(scene)
+            unstable, why, decay = steady_state_stability(scene)
             cell.update(status=CellStatus.UNSTABLE if unstable else cell["status"],
                         reason=f"{why}; {res.reason}" if unstable else f"{res.reason}; {why}")
+            num = sim.numerics
+            needed = math.log(1.0 / num.steady_tol) / decay if decay > 0 else math.inf
+            if (not unstable and res.status is RunStatus.REACHED_END
+                    and needed > num.t_end - num.settle_time):
+                # stable, but its slowest mode cannot decay to steady_tol within t_end:
+                # the physics is slower than the default span, not a numerical failure
+                cell.update(status=CellStatus.BOUNDED, reason=(
+                    f"stable but slow: settling to steady_tol {num.steady_tol:g} takes about "
+                    f"{needed:.3g} s after the drive (ln(1/steady_tol) over the decay rate), "
+                    f"more than t_end leaves ({num.t_end - num.settle_time:.3g} s); raise "
+                    f"numerics.t_end; {cell['reason']}"))
     else:
         over = [f"{k} {err[k]:.3g} > {b:g}" for k, b in BOUNDS.items()
                 if err.get(k) is not None and not err[k] <= b]
@@ -160,9 +171,10 @@ def stability_cell(case: Case, scheme: str, extra=()) -> dict:
     return cell
 
 
-def steady_state_stability(scene) -> tuple[bool, str]:
-    """(unstable, why): whether the scene's discrete steady state (its grid) is linearly
-    unstable by a clear margin (GROWTH_MARGIN), and a sentence with the growth rate."""
+def steady_state_stability(scene) -> tuple[bool, str, float]:
+    """(unstable, why, decay): whether the scene's discrete steady state (its grid) is
+    linearly unstable by a clear margin (GROWTH_MARGIN), a sentence with the growth rate,
+    and the least stable mode's decay rate (1/s; 0 when it grows or is unknown)."""
     from ..physics.modes import steady_scene
 
     key = steady_scene(scene).to_toml()  # the time-stepping keys do not change the verdict
@@ -171,22 +183,23 @@ def steady_state_stability(scene) -> tuple[bool, str]:
     return _VERDICTS[key]
 
 
-_VERDICTS: dict[str, tuple[bool, str]] = {}  # per scene: implicit and explicit share it
+_VERDICTS: dict[str, tuple[bool, str, float]] = {}  # per scene: implicit, explicit share it
 
 
-def _stability_verdict(scene) -> tuple[bool, str]:
+def _stability_verdict(scene) -> tuple[bool, str, float]:
     from ..physics.modes import growth_rate
 
     try:
         g = growth_rate(scene)
     except Exception as exc:  # noqa: BLE001  no verdict leaves the cell as it was
-        return False, f"no linear stability verdict ({type(exc).__name__}: {exc})"
+        return False, f"no linear stability verdict ({type(exc).__name__}: {exc})", 0.0
     P = scene.params
     margin = GROWTH_MARGIN * max(math.hypot(g.rate, 2 * math.pi * g.frequency), P.c / P.L)
     if g.rate > margin:
         return True, (f"the steady state is linearly unstable: {g.describe()} on this grid "
-                      f"({g.elements} elements), so no run can settle: the model flutters")
-    return False, (f"the steady state is linearly stable on this grid: {g.describe()}")
+                      f"({g.elements} elements), so no run can settle: the model flutters"), 0.0
+    return (False, f"the steady state is linearly stable on this grid: {g.describe()}",
+            max(-g.rate, 0.0))
 
 
 def stability_matrix(cases=STABILITY_CASES, schemes=None, extra=(), progress=None):
