@@ -177,3 +177,10 @@ def test_valid_scenes_converge_within_bounds_or_are_refused(L, x1f, x2f, cfrac, 
     # the simulator's (0.5% friction, 2% u) widened by that factor
     assert err["total_friction"] < 0.0125 and err["u"] < 0.05
     assert err["slip_start"] < 0.0125 * L
+
+
+def test_python_dash_m_beltsim_is_the_command():
+    proc = subprocess.run([sys.executable, "-m", "beltsim", "run", "missing.toml"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("beltsim: error:") and "Traceback" not in proc.stderr
