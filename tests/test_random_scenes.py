@@ -171,8 +171,10 @@ def test_the_deferred_schemes_get_their_share_of_max_wall(monkeypatch):
 
 def test_an_undamped_scene_still_ringing_at_t_end_counts_as_bounded():
     """Undamped, only friction dissipates and a time-accurate run may ring past t_end: it
-    says so (not steady) and the study counts it like the matrix's span cases; a damped
-    scene that has not settled stays a failure."""
+    says so (not steady) and the study counts it like the matrix's span cases. The damped
+    scene cut as short is judged by its slowest mode instead (decaying at ~10 1/s it needs
+    ~1.3 s, not the 0.003 s left after the ramp): bounded, stable but slow; a damped cell
+    that could have settled stays a failure (tests/test_modes.py)."""
     scene = load_scene(runs_dir() / "paper_slip.toml", ["numerics.elements=120"])
     short = ("numerics.t_end=0.02",)
     undamped = rs.random_cell(scene.with_overrides(["physics.damping=0"]), 0, "implicit",
@@ -180,7 +182,8 @@ def test_an_undamped_scene_still_ringing_at_t_end_counts_as_bounded():
     assert undamped["status"] == CellStatus.BOUNDED.value, undamped
     assert undamped["reason"].startswith("undamped, still ringing: not steady by t_end")
     damped = rs.random_cell(scene, 1, "implicit", extra=short)
-    assert damped["status"] == CellStatus.NOT_CONVERGED.value and rs.failed(damped), damped
+    assert damped["status"] == CellStatus.BOUNDED.value and not rs.failed(damped), damped
+    assert damped["reason"].startswith("stable but slow")
 
 
 def test_jobs_give_the_same_rows_in_the_same_order(monkeypatch):

@@ -153,11 +153,12 @@ def stability_cell(case: Case, scheme: str, extra=()) -> dict:
             cell.update(status=CellStatus.UNSTABLE if unstable else cell["status"],
                         reason=f"{why}; {res.reason}" if unstable else f"{res.reason}; {why}")
             num = sim.numerics
-            needed = math.log(1.0 / num.steady_tol) / decay if decay > 0 else math.inf
-            if (not unstable and res.status is RunStatus.REACHED_END
-                    and needed > num.t_end - num.settle_time):
-                # stable, but its slowest mode cannot decay to steady_tol within t_end:
-                # the physics is slower than the default span, not a numerical failure
+            needed = math.log(1.0 / num.steady_tol) / decay if decay > 0 else 0.0
+            if (not unstable and res.status is RunStatus.REACHED_END and decay > 0
+                    and scene.params.damping > 0 and needed > num.t_end - num.settle_time):
+                # damped and stable, but its slowest mode cannot decay to steady_tol within
+                # t_end: the physics is slower than the default span, not a numerical
+                # failure (an undamped scene rings on: the random study's own rule)
                 cell.update(status=CellStatus.BOUNDED, reason=(
                     f"stable but slow: settling to steady_tol {num.steady_tol:g} takes about "
                     f"{needed:.3g} s after the drive (ln(1/steady_tol) over the decay rate), "
