@@ -44,11 +44,7 @@ def is_exact(code) -> bool:
 
 @njit(cache=True)
 def law(code, s):
-    """g(s) and g'(s) of the regularisation ``code``.
-
-    The exact laws have none: EXACT answers with the projection of s onto [-1, 1]
-    (lam = proj(0 + s), the first augmented estimate from lam = 0), ADHESION with s.
-    """
+    """g(s) and g'(s) of the regularisation ``code`` (the exact laws have none)."""
     if code == TANH:
         # through exp, which is cheaper than libm's tanh; exact to round-off
         e = math.exp(-2.0 * abs(s))
@@ -57,7 +53,7 @@ def law(code, s):
     if code == SQRT:
         r = 1.0 / math.sqrt(1.0 + s * s)
         return s * r, r * r * r
-    if code == RAMP or code == EXACT:
+    if code == RAMP:
         if s > 1.0:
             return 1.0, 0.0
         if s < -1.0:
@@ -107,7 +103,7 @@ def law_numpy(code, s):
     if code == SQRT:
         r = 1.0 / np.sqrt(1.0 + s * s)
         return s * r, r**3
-    if code in (RAMP, EXACT):
+    if code == RAMP:
         return np.clip(s, -1.0, 1.0), (np.abs(s) <= 1.0).astype(float)
     return s, np.ones_like(s)
 

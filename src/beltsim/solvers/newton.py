@@ -205,8 +205,6 @@ def release_stuck_ratios(lam, w, mesh, code):
     1 + 2 |rl| per iteration), and Newton goes on.
     """
     stuck = False
-    if code >= EXACT:  # a projected ratio sits on the bound exactly when it slides
-        return stuck
     for j in range(mesh.c0, mesh.j2 + 1):
         if w.sg[j] < NEAR_BOUND and lam[j] * w.rl[j] < 0.0:
             s = w.rl[j] + law_inverse(code, w.lam0[j])[0]
@@ -214,6 +212,16 @@ def release_stuck_ratios(lam, w, mesh, code):
                 lam[j] = 0.0
                 stuck = True
     return stuck
+
+
+@njit(cache=True, inline="always")
+def update_converged(update, previous, it, tol):
+    """Newton's stopping rule on the size of an update (see :func:`newton`): below tol;
+    or at the round-off floor (below ROUNDOFF_FLOOR tol, no longer halving); or the
+    error it leaves, rate / (1 - rate) times the update, below tol."""
+    rate = update / previous if it > 0 and previous > 0.0 else 1.0
+    return (update < tol or (update < ROUNDOFF_FLOOR * tol and update > 0.5 * previous)
+            or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol))
 
 
 @njit(cache=True)
@@ -269,9 +277,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
                 u[i + 1] += dx[i, 0]
                 th[i + 1] += dx[i, 1]
             update = max(step, dlam)
-            rate = update / previous if it > 0 and previous > 0.0 else 1.0
-            if ((update < tol or (update < ROUNDOFF_FLOOR * tol and update > 0.5 * previous)
-                    or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol))
+            if (update_converged(update, previous, it, tol)
                     and not release_stuck_ratios(lam, w, mesh, p.law)):
                 friction_forces(lam, fnode, t, mesh, p, drive)
                 return True
@@ -356,12 +362,11 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
         assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
         changed = saddle_system(lam, inv_dt, fs, mesh, p, w, s)
         update = max(step, dlam)
-        rate = update / previous if it > 0 and previous > 0.0 else 1.0
+        done = changed == 0 and update_converged(update, previous, it, tol)
         previous = update
-        if changed == 0 and (update < tol
-                             or (update < ROUNDOFF_FLOOR * tol and rate > 0.5)
-                             or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol)):
+        if done:
             project(lam, mesh, p.law)  # the sliding ratios, off +-1 by round-off
+            friction_forces(lam, fnode, t, mesh, p, drive)
             add_stick_penalty(w, inv_dt, fs, mesh, p)
             return factorise(w, mesh)
     st.merit = merit(w.R, scales)

@@ -153,16 +153,17 @@ def stability_cell(case: Case, scheme: str, extra=()) -> dict:
             cell.update(status=CellStatus.UNSTABLE if unstable else cell["status"],
                         reason=f"{why}; {res.reason}" if unstable else f"{res.reason}; {why}")
             num = sim.numerics
+            span = num.t_end - num.settle_time
             needed = math.log(1.0 / num.steady_tol) / decay if decay > 0 else 0.0
-            if (not unstable and res.status is RunStatus.REACHED_END and decay > 0
-                    and scene.params.damping > 0 and needed > num.t_end - num.settle_time):
+            if (res.status is RunStatus.REACHED_END and scene.params.damping > 0
+                    and needed > span):
                 # damped and stable, but its slowest mode cannot decay to steady_tol within
                 # t_end: the physics is slower than the default span, not a numerical
                 # failure (an undamped scene rings on: the random study's own rule)
                 cell.update(status=CellStatus.BOUNDED, reason=(
                     f"stable but slow: settling to steady_tol {num.steady_tol:g} takes about "
                     f"{needed:.3g} s after the drive (ln(1/steady_tol) over the decay rate), "
-                    f"more than t_end leaves ({num.t_end - num.settle_time:.3g} s); raise "
+                    f"more than t_end leaves ({span:.3g} s); raise "
                     f"numerics.t_end; {cell['reason']}"))
     else:
         over = [f"{k} {err[k]:.3g} > {b:g}" for k, b in BOUNDS.items()
