@@ -60,15 +60,17 @@ def test_exact_adhesion_has_no_slip_velocity():
 def test_second_order_without_a_regularisation_floor(name):
     # measured (steady, 250 ... 8000 elements): order 2.00 for every quantity, 1.1e-7
     # total friction on 8000 elements; the regularised default flattens at ~2e-6 from
-    # 1000 elements on. Here 1000 and 4000 elements: a factor 16 +-25% (order 1.8-2.2),
-    # and below 1e-6 on 4000 (under the regularised floor)
+    # 1000 elements on. Here 1000 and 4000 elements: a factor 16 +-25% (order 1.8-2.2).
+    # On 4000 elements (default grading 5) measured total friction, u, theta: 4.4e-7,
+    # 5.0e-7, 1.4e-6 (paper_inertia), 3.0e-7, 2.8e-7, 3.5e-7 (paper_quasistatic); the
+    # bounds are the larger + 25%
     errs = [_run(name, "numerics.integrator=steady", f"numerics.elements={n}").errors()
             for n in (1000, 4000)]
     for key in ("total_friction", "u", "theta", "concentrated_force"):
         order = math.log(errs[0][key] / errs[1][key]) / math.log(4.0)
         assert 1.8 < order < 2.2, (key, order)
-    for key in ("total_friction", "u", "theta"):
-        assert errs[1][key] < 1e-6, (key, errs[1][key])
+    for key, bound in (("total_friction", 5.5e-7), ("u", 6.3e-7), ("theta", 1.75e-6)):
+        assert errs[1][key] < bound, (key, errs[1][key])
 
 
 def test_slip_scene_total_friction_falls_at_second_order():

@@ -49,7 +49,7 @@ def test_sigterm_writes_a_checkpoint_and_resume_finishes(tmp_path):
     # a run of several seconds (backward Euler at a small fixed step), so that the
     # signal lands after start-up and before the end
     args = [scene_path("paper_slip"), "--set", "numerics.integrator=pseudo", "--set",
-            "numerics.dt=1e-5", "--quiet"]
+            "numerics.dt=1e-5", "--set", "numerics.elements=1500", "--quiet"]
     ref = subprocess.run([sys.executable, "-m", "beltsim.cli", "run", *args, "--out",
                           str(tmp_path / "ref")], capture_output=True, text=True, timeout=600)
     assert ref.returncode == 0, ref.stderr

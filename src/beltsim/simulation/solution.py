@@ -215,14 +215,19 @@ class DiscreteSolution:
         smooth = np.array([self._stick_traction_at(layer[0], g.x[j]) for j in layer])
         return float(np.sum(self.fnode[layer] - smooth * self.wf[layer]))
 
-    def summary(self) -> dict:
+    def summary(self, path: bool = False) -> dict:
+        """The analytic solution's quantities read off this state. slip_power: the steady
+        energy balance's (:attr:`steady_slip_power`), or with ``path`` (a state on the way,
+        where that balance does not hold) the friction law's dissipation now
+        (:attr:`slip_power`)."""
         total = self.total_friction
+        power = self.slip_power if path else self.steady_slip_power
         if self.model == "stick":
             conc = self.concentrated_force
             return {"model": "stick", "inertia": self.params.inertia, "total_friction": total,
                     "concentrated_force": conc, "distributed_friction": total - conc,
                     "stick_friction": None, "slip_friction": None, "slip_start": None,
-                    "slip_power": self.steady_slip_power}
+                    "slip_power": power}
         xs, p = self._slip_front()
         s = self._sliding()
         slip = float(self.fnode[s].sum())
@@ -232,7 +237,7 @@ class DiscreteSolution:
         return {"model": "slip", "inertia": self.params.inertia, "total_friction": total,
                 "concentrated_force": None, "distributed_friction": None,
                 "stick_friction": total - slip, "slip_friction": slip,
-                "slip_start": xs, "slip_power": self.steady_slip_power}
+                "slip_start": xs, "slip_power": power}
 
 
 def compare(sim: DiscreteSolution, ref: AnalyticSolution) -> dict:

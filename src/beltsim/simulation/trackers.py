@@ -85,11 +85,7 @@ class HistoryTracker(Tracker):
         self.data = {k: [] for k in self.keys}
 
     def handle(self, sim):
-        sol = sim.solution()
-        summary = sol.summary()
-        # on the path, the friction law's dissipation now (the summary's steady balance
-        # holds only at a steady state)
-        summary["slip_power"] = sol.slip_power
+        summary = sim.solution().summary(path=True)
         self.data["t"].append(sim.t)
         self.data["rate"].append(sim.rate())
         for k in self.keys:

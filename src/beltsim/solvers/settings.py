@@ -2,10 +2,15 @@
 
 Defaults (all overridable in [numerics]):
 
-* ``elements`` max(1000, 16 L max(alpha, beta)): 1000, or more where theta decays
-  over a shorter length than the paper's 17 mm; ``grading`` 8 (smallest elements at
-  x2 and at the analytic slip start, where friction jumps to f*: x1 when the whole
-  contact slides; largest 8x bigger);
+* ``elements`` max(600, 10 L max(alpha, beta)): 600, or more where theta decays
+  over a shorter length than the paper's 17 mm (10 elements per decay length, as 600
+  give the paper's); ``grading`` 5 (smallest elements at x2 and at the analytic slip
+  start, where friction jumps to f*: x1 when the whole contact slides; largest 5x
+  bigger). Chosen for the second-order model so that the default paper slip run meets
+  its targets with a margin (steady errors on 600 elements, grading 5: total friction
+  9.2e-6, u 8.7e-6, theta 3.9e-5, slip start 4.2e-7 m, against 2e-5, 5e-5, 5e-4 and
+  2e-5 m) at 60% of the old 1000 elements' cost. Grading 4 gave 7.8e-6 but a
+  concentrated-force error of the stick scenes 1.2 to 2 times grading 5's; 8, 1.3e-5;
 * ``ramp_time`` 2 L / c: the surface speed goes smoothly from c to v (a number or a
   sine; a table sets its own times, :mod:`beltsim.problem.drive`);
 * ``dt`` max(ramp_time, L / c) / 50;
@@ -28,8 +33,9 @@ Defaults (all overridable in [numerics]):
   path but not the steady state;
 * ``time_tol`` 4e-6: the relative local error per step of the time-accurate
   implicit scheme; chosen so that the paper slip history (total friction at every
-  check, default grid) stays within 1e-3 of a converged one (measured 7.6e-4; 8.8e-4
-  at 5e-6, 5.6e-3 at 1e-4);
+  check, default grid) stays within 1e-3 of a converged one (measured 6.3e-4 against
+  time_tol 1e-7 on 600 elements, 7.6e-4 on the old 1000; there 8.8e-4 at 5e-6, 5.6e-3
+  at 1e-4);
 * ``steady_tol`` 1e-6: relative rates and relative change of the total friction
   per window (one transit time L / c) that count as steady;
 * ``newton_tol`` 1e-9 (scaled max norm of the Newton update) and
@@ -57,12 +63,14 @@ from ..problem.drive import largest_mismatch, period_of, profile_times, speed_ra
 from ..problem.scene import Params, Scene
 from . import registry
 
-DEFAULT_ELEMENTS = 1000
-DEFAULT_GRADING = 8.0
+DEFAULT_ELEMENTS = 600
+DEFAULT_GRADING = 5.0
 # default elements per L / l_min, l_min the shortest decay length of theta (1/beta in
-# free segments, 1/alpha in stick): 16 resolves the paper's 17 mm layer like 1000
-# elements do, and keeps the theta error below 2% where 1000 elements did not (h = 0.01 m)
-ELEMENTS_PER_LAYER = 16.0
+# free segments, 1/alpha in stick): 10 resolves the paper's 17 mm layer as the 600
+# default elements do (thinner belts, paper data without inertia, steady: h = 0.01 m,
+# 2134 elements, theta errors 5.8e-5 (slip) and 2.3e-4 (perfect adhesion); h = 0.003 m,
+# 7112 elements, 3.7e-5 and 4.5e-4)
+ELEMENTS_PER_LAYER = 10.0
 DEFAULT_TIME_TOL = 4e-6
 MIN_MISMATCH = 1e-8  # smallest nonzero |v/c - 1| a run accepts
 DEFAULT_MAX_WORK = 2e10  # node-steps of an explicit run
