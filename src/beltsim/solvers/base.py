@@ -38,13 +38,9 @@ class Discretisation:
     """
 
     def __init__(self, scene: Scene, grid: Grid | None = None):
-        import dataclasses
-
         self.scene = scene
         self.params = P = scene.params
-        num = resolve(scene)
-        if grid is not None:
-            num = dataclasses.replace(num, elements=grid.n_elements)
+        num = resolve(scene, None if grid is None else grid.n_elements)
         self.numerics: Numerics = num
         self.grid: Grid = grid if grid is not None else build_grid(scene, num)
         self.mesh: Mesh = mesh_of(self.grid)

@@ -16,12 +16,16 @@ Defaults (all overridable in [numerics]):
 * ``dt`` max(ramp_time, L / c) / 50;
 * ``t_end`` T + 400 L / c, T the end of the drive's changes (the ramp, the last row of
   every table); a run that has not settled by then stops with converged = false;
-* ``regularisation`` (coulomb) v_reg = 1e-4 |v - c|, v the final surface speed (the
-  largest |v(t) - c| of the profile when that is 0 or the drive is periodic): the creep velocity in
-  stick zones is then ~1e-4 of the imposed one and the layer
+* ``regularisation`` (coulomb) v_reg = 1e-4 |v - c| r, v the final surface speed (the
+  largest |v(t) - c| of the profile when that is 0 or the drive is periodic) and
+  r = min(1, max(0.01, (N0 / N)^2)), N the grid's elements and N0 the default's: on the default
+  grid the creep velocity in stick zones is ~1e-4 of the imposed one and the layer
   (b1 - rho c^2) v_reg / (c f*) that replaces the jump at x* is far below an
-  element, so the regularisation error stays well below the grid's;
-* ``adhesion_layer`` (stick) delta = 1e-6 L: perfect adhesion is the linear law
+  element. The regularisation's error is first order in v_reg (2e-6 of the total
+  friction on paper slip at 1e-4 |v - c|), so a fixed v_reg left a floor that finer
+  grids hit from 1000 elements on; shrunk with the grid as h^2 it stays the same
+  fraction of the grid's error and the errors fall at second order;
+* ``adhesion_layer`` (stick) delta = 1e-6 L r: perfect adhesion is the linear law
   f = -kappa v_rel with kappa = (b1 - rho c^2) / (c delta), which spreads the
   concentrated force over a layer of width delta upstream of x2;
 * ``friction_law`` "tanh" (coulomb), the adhesion layer (stick); "exact" for either:
@@ -78,6 +82,11 @@ EXPLICIT_RATE = 3e7  # node-steps per second of the explicit kernel (bench), for
 MEMORY_PER_NODE = 600  # bytes a grid node costs a run at its peak
 MIN_VREG = 1e-12  # smallest regularisation velocity, relative to c
 DEFAULT_ADHESION_LAYER = 1e-6  # delta / L
+# Smallest factor on the default v_reg and delta as the grid is refined (10 times the
+# default elements): 1e-6 |v - c| and 1e-8 L were measured clean to 4000 elements, where
+# 5.6e-9 L (8000 elements) left the stick scenes' concentrated force at 4e-7, Newton's
+# round-off floor with so stiff a law
+MIN_REFINE = 1e-2
 
 
 @dataclass(frozen=True)
@@ -105,9 +114,17 @@ class Numerics:
         return LAW_CODES[self.law]
 
 
-def resolve(scene: Scene) -> Numerics:
+def resolve(scene: Scene, elements: int | None = None) -> Numerics:
+    """The scene's numerical settings with their defaults; ``elements`` stands for
+    numerics.elements (a grid given apart, e.g. a bisected one)."""
     P = scene.params
     nm = scene.numerics
+    if elements is None:
+        elements = nm.get("elements", default_elements(P))
+    check_memory(elements)
+    # the regularisation's own error (first order in v_reg or delta) shrinks with the
+    # grid's, as h^2, on grids finer than the default, down to MIN_REFINE
+    refine = min(1.0, max(MIN_REFINE, (default_elements(P) / elements) ** 2))
     transit = P.L / P.c
     ramp_time = nm.get("ramp_time", 2.0 * transit)
     dt = nm.get("dt", max(ramp_time, transit) / 50.0)
@@ -137,14 +154,14 @@ def resolve(scene: Scene) -> Numerics:
         else:
             law, fs = "adhesion", P.B * vreg / (P.c * DEFAULT_ADHESION_LAYER * P.L)
     elif P.friction == "coulomb":
-        vreg = nm.get("regularisation", default_vreg)
+        vreg = nm.get("regularisation", max(default_vreg * refine, MIN_VREG * P.c))
         law, fs = nm.get("friction_law", "tanh"), P.fstar
         if vreg < MIN_VREG * P.c:
             raise SceneError(f"numerics.regularisation: must be >= {MIN_VREG:g} c = "
                              f"{MIN_VREG * P.c:.3g} m/s (below it slip velocities drown in "
                              f"round-off), got {vreg!r}")
     else:
-        delta = nm.get("adhesion_layer", DEFAULT_ADHESION_LAYER * P.L)
+        delta = nm.get("adhesion_layer", DEFAULT_ADHESION_LAYER * P.L * refine)
         law, vreg = "linear", 1.0
         fs = P.B / (P.c * delta)
     accelerated = registry.get(integrator).accelerated
@@ -160,8 +177,6 @@ def resolve(scene: Scene) -> Numerics:
     if "max_work" in nm and integrator != "explicit":
         raise SceneError('numerics.max_work: only for numerics.integrator = "explicit" (the '
                          "other schemes' steps adapt)")
-    elements = nm.get("elements", default_elements(P))
-    check_memory(elements)
     return Numerics(
         integrator=integrator,
         elements=elements,
