@@ -13,7 +13,7 @@ from beltsim.physics.friction import (
     law_inverse,
     law_numpy,
 )
-from beltsim.physics.grid import make_grid
+from beltsim.physics.grid import bisect, make_grid
 from beltsim.physics.model import (
     Loads,
     State,
@@ -262,6 +262,25 @@ def test_grid_has_nodes_at_contact_ends(grading):
         assert np.argmin(he) in (g.j2 - 1, g.j2)
     assert he.max() / he.min() == pytest.approx(grading, rel=0.1)
     np.testing.assert_allclose(g.hbar.sum(), 1.0)
+
+
+@pytest.mark.parametrize("grading", [1.0, 5.0])
+def test_grid_has_a_node_at_an_inner_refinement_point(grading):
+    """The expected slip start inside the contact is a node, kept by bisection; one
+    within two elements of x2 is only graded towards (no sliver elements)."""
+    x_star = 0.634134
+    g = make_grid(1.0, 1 / 3, 2 / 3, 600, grading, refine_at=(x_star,))
+    assert g.n_elements == 600 and np.all(np.diff(g.x) > 0)
+    assert g.x[g.j1] == 1 / 3 and g.x[g.j2] == 2 / 3
+    k = int(np.argmin(np.abs(g.x - x_star)))
+    assert g.x[k] == x_star and g.j1 < k < g.j2
+    he = g.he  # the anchor does not disturb the grading: neighbours within 10%
+    assert he[k] / he[k - 1] == pytest.approx(1.0, rel=0.1)
+    assert np.isin(x_star, bisect(g).x)
+    h_min = make_grid(1.0, 1 / 3, 2 / 3, 600, grading).h_min
+    near = 2 / 3 - 1.5 * h_min  # 1.5 smallest elements from x2
+    g2 = make_grid(1.0, 1 / 3, 2 / 3, 600, grading, refine_at=(near,))
+    assert not np.isin(near, g2.x) and g2.h_min > 0.9 * h_min
 
 
 def test_law_codes_cover_scene_choices():
