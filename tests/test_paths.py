@@ -43,10 +43,10 @@ def test_history_converges_as_time_tol_shrinks(ladder):
 def test_the_default_time_tol_keeps_the_path_within_1e_3(ladder):
     """The default time_tol is chosen for this: the history within 1e-3 of a converged
     one (max over the checks, relative to the steady total friction). Measured here
-    (300 elements, 0.15 s) against time_tol 1e-7: 4.3e-4 (1830 steps); on the
-    default 1000 elements over the whole run 7.4e-4 (1e-4, the old default, to 0.3 s on
-    the first-order model: 5.6e-3). The 1e-7
-    run's own error, ~(1e-7 / 4e-6)^(2/3) = 0.09 of the default's, is inside the margin."""
+    (300 elements graded 8, 0.15 s) against time_tol 1e-7: 7.0e-4 (1484 steps) at the
+    default 6e-6, 4.3e-4 (1830) at 4e-6; on the default 600 elements over the whole run
+    8.7e-4 (1e-4, an older default, to 0.3 s on the first-order model: 5.6e-3). The 1e-7
+    run's own error, ~(1e-7 / 6e-6)^(2/3) = 0.07 of the default's, is inside the margin."""
     ref, run = ladder[1e-7], _run()
     F = abs(ref.reference.total_friction)
     d = np.abs(run.history["total_friction"] - ref.history["total_friction"]).max() / F

@@ -225,9 +225,10 @@ def test_thin_needs_the_stiffness_held_fixed():
 #
 # the same to 4 digits when run to steady state. With the default tanh law, whose v_reg
 # shrinks with the grid, measured with time_tol 1e-9: 3.5e-5, 1.2e-5, 3.0e-6, 8.0e-7
-# (coulomb; a fixed v_reg = 1e-4 |v - c| stopped at 4.4e-6 from 1000 elements on). Adaptive steps with
-# time_tol / 8 per rung (1e-4 on 250 elements; error ~ time_tol^(2/3)) give 4.5e-4,
-# 1.3e-4, 3.9e-5, 1.1e-5 (coulomb, orders 1.84, 1.68, 1.81): the time error dominates.
+# (coulomb; a fixed v_reg = 1e-4 |v - c| stopped at 4.4e-6 from 1000 elements on).
+# Adaptive steps with time_tol / 8 per rung (1e-4 on 250 elements; error ~
+# time_tol^(2/3)) give 4.5e-4, 1.3e-4, 3.9e-5, 1.1e-5 (coulomb, exact law, orders 1.84,
+# 1.68, 1.81): the time error dominates.
 #
 # Pseudo (backward Euler, first order in dt; dt = 2^-12 s on 250 elements, halved with
 # h; default law), measured:

@@ -506,7 +506,8 @@ def stored_energy(state, mesh: Mesh, p: ModelParams) -> float:
 
 def strain_numpy(ub, sw, j):
     """d/dx u_b at the friction nodes j (array) from the stencil weights sw."""
-    return sum(sw[j, o] * ub[np.minimum(j - 2 + o, len(ub) - 1)] for o in range(4))
+    k = np.minimum(np.asarray(j)[..., None] + np.arange(-2, 2), len(ub) - 1)
+    return np.sum(sw[j] * ub[k], axis=-1)
 
 
 def forces_numpy(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, loads=None):

@@ -70,6 +70,7 @@ class DiscreteSolution:
         # a run passes its mesh's rather than rebuild them at every check)
         self.c0, self.wf, self.sw = (contact_stencil(grid.x, grid.j1, grid.j2)
                                      if stencil is None else stencil)
+        self._slides = None  # the sliding mask, once read (the state does not change)
 
     @property
     def x(self):
@@ -93,10 +94,12 @@ class DiscreteSolution:
 
     def _sliding(self):
         """Boolean per node: the friction node slides (|f| >= saturation f*)."""
-        s = np.zeros_like(self.fnode, dtype=bool)
-        on = self.wf > 0.0
-        s[on] = np.abs(self.fnode[on] / self.wf[on]) / self.fs >= saturation(self.law_code)
-        return s
+        if self._slides is None:
+            s = np.zeros_like(self.fnode, dtype=bool)
+            on = self.wf > 0.0
+            s[on] = np.abs(self.fnode[on] / self.wf[on]) / self.fs >= saturation(self.law_code)
+            self._slides = s
+        return self._slides
 
     def _control_volume(self, j):
         """The contact part [a, b] of node j's control volume."""
@@ -108,16 +111,16 @@ class DiscreteSolution:
     def _stick_traction_at(self, p, xq):
         """The stick traction extrapolated to xq from the FIT friction nodes before p
         (quadratic; fewer near x1)."""
-        k = range(max(self.c0, p - FIT), p)
-        x = self.grid.x
-        f = {i: self.fnode[i] / self.wf[i] for i in k}
-        value = 0.0  # Lagrange interpolation through the nodes k
-        for i in k:
+        lo = max(self.c0, p - FIT)
+        x = self.grid.x[lo:p].tolist()
+        f = (self.fnode[lo:p] / self.wf[lo:p]).tolist()
+        value = 0.0  # Lagrange interpolation through the nodes lo .. p - 1
+        for i, (xi, fi) in enumerate(zip(x, f)):
             li = 1.0
-            for m in k:
+            for m, xm in enumerate(x):
                 if m != i:
-                    li *= (xq - x[m]) / (x[i] - x[m])
-            value += li * f[i]
+                    li *= (xq - xm) / (xi - xm)
+            value += li * fi
         return float(value)
 
     def _slip_front(self):
