@@ -286,3 +286,16 @@ def test_grid_has_a_node_at_an_inner_refinement_point(grading):
 def test_law_codes_cover_scene_choices():
     from beltsim.problem.scene import SCHEMA
     assert set(SCHEMA["numerics"]["friction_law"].choices) <= set(LAW_CODES)
+
+
+def test_bounds_checked_kernels_keep_their_own_cache():
+    """A bounds-checked session must not fill the source tree's numba cache (conftest):
+    ordinary runs would load its slower kernels."""
+    import os
+
+    import numba
+
+    if os.environ.get("NUMBA_BOUNDSCHECK", "0") in ("", "0"):
+        pytest.skip("only a bounds-checked session caches apart")
+    assert numba.config.BOUNDSCHECK
+    assert numba.config.CACHE_DIR and "beltsim-numba-boundscheck" in numba.config.CACHE_DIR
