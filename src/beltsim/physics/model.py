@@ -310,12 +310,15 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
             ru -= hbj * load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j)
             rt -= hbj * load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j)
         if want_jac:
-            for a_ in range(2):
-                for b_ in range(2):
-                    Lb[i, a_, b_] = 0.0
-                    L2[i, a_, b_] = 0.0
-                    Db[i, a_, b_] = 0.0
-                    Ub[i, a_, b_] = 0.0
+            if j >= c0 and j <= j2:
+                # friction adds to these rows' couplings and second band; elsewhere they
+                # keep the zeros they were allocated with (the blocks' other entries)
+                for a_ in range(2):
+                    for b_ in range(2):
+                        Lb[i, a_, b_] = 0.0
+                        L2[i, a_, b_] = 0.0
+                        Db[i, a_, b_] = 0.0
+                        Ub[i, a_, b_] = 0.0
             Db[i, 0, 0] = rho * hbj * kin + rho * gyro * inv_dt + B * (1.0 / hl + 1.0 / hr)
             Lb[i, 0, 0] = -rho * gyro * inv_dt - B / hl
             Ub[i, 0, 0] = -B / hr
