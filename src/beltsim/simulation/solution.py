@@ -108,13 +108,16 @@ class DiscreteSolution:
         b = x[j] if j == g.j2 else 0.5 * (x[j] + x[j + 1])
         return a, b
 
-    def _stick_traction_at(self, p, xq):
-        """The stick traction extrapolated to xq from the FIT friction nodes before p
-        (quadratic; fewer near x1)."""
+    def _stick_fit(self, p):
+        """The FIT friction nodes before p (fewer near x1): their x and traction, as lists."""
         lo = max(self.c0, p - FIT)
-        x = self.grid.x[lo:p].tolist()
-        f = (self.fnode[lo:p] / self.wf[lo:p]).tolist()
-        value = 0.0  # Lagrange interpolation through the nodes lo .. p - 1
+        return (self.grid.x[lo:p].tolist(), (self.fnode[lo:p] / self.wf[lo:p]).tolist())
+
+    @staticmethod
+    def _extrapolate(fit, xq):
+        """The Lagrange polynomial through the points ``fit`` (quadratic for three) at xq."""
+        x, f = fit
+        value = 0.0
         for i, (xi, fi) in enumerate(zip(x, f)):
             li = 1.0
             for m, xm in enumerate(x):
@@ -122,6 +125,11 @@ class DiscreteSolution:
                     li *= (xq - xm) / (xi - xm)
             value += li * fi
         return float(value)
+
+    def _stick_traction_at(self, p, xq):
+        """The stick traction extrapolated to xq from the FIT friction nodes before p
+        (quadratic; fewer near x1)."""
+        return self._extrapolate(self._stick_fit(p), xq)
 
     def _slip_front(self):
         """(x*, p): the slip start read inside the cell, and the node whose control volume
@@ -154,14 +162,16 @@ class DiscreteSolution:
     def _front_in(self, p):
         """x* read from node p's force, clipped to its volume [a, b], and how far
         inside it lies (min(x* - a, b - x*) / (b - a))."""
-        a, b = self._control_volume(p)
-        fslip = np.sign(self.fnode[self.grid.j2]) * self.fs
+        a, b = (float(v) for v in self._control_volume(p))
+        fslip = float(np.sign(self.fnode[self.grid.j2])) * self.fs
+        fp = float(self.fnode[p])
+        fit = self._stick_fit(p)
         xs = 0.5 * (a + b)
         for _ in range(3):  # f_stick at the middle of [a, x*]
-            fst = self._stick_traction_at(p, 0.5 * (a + xs))
+            fst = self._extrapolate(fit, 0.5 * (a + xs))
             if fslip == fst:
                 break
-            xs = (self.fnode[p] - fslip * b + fst * a) / (fst - fslip)
+            xs = (fp - fslip * b + fst * a) / (fst - fslip)
             xs = min(b, max(a, xs))
         return float(xs), min(xs - a, b - xs) / (b - a)
 
@@ -185,7 +195,7 @@ class DiscreteSolution:
         ub = self.u + hh * self.theta
         vrel = (self.ud[j] + hh * self.td[j] + P.c * strain_numpy(ub, self.sw, j)
                 - self.mismatch)
-        return float(-np.sum(self.fnode[j] * vrel))
+        return float(-np.dot(self.fnode[j], vrel))
 
     @property
     def steady_slip_power(self) -> float:
