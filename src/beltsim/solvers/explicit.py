@@ -23,8 +23,8 @@ semi-discrete steady state of the implicit schemes.
 G is upwind, 2 rho c hbar_j (v_j - v_{j-1}) / h_{j-1}, as in the model the Newton
 schemes solve (physics.model), so all schemes share the semi-discretisation. Measured
 on the linearisation of the semi-discrete model at the paper slip steady state
-(1000 elements graded 8, the default then): with the central term it is unstable, real parts up to +2.5/s with
-d = 39/s and +9/s with d = 0 (friction in the stick zone pumps the rotation modes), and
+(1000 elements graded 8, the default then): with the central term it is unstable, real
+parts up to +2.5/s with d = 39/s and +9/s with d = 0 (friction in the stick zone pumps the rotation modes), and
 a time-accurate scheme follows it and never settles (BDF2 at time_tol 1e-7 had not
 settled after 3 s on 300 elements; the default implicit run settles through BDF2's
 damping at its large steps). With the upwind term the slowest mode decays at 10/s with
