@@ -21,21 +21,21 @@ h / (c + sqrt(b1 / rho))). Both parts vanish at rest, so the fixed point is the
 semi-discrete steady state of the implicit schemes.
 
 G is upwind, 2 rho c hbar_j (v_j - v_{j-1}) / h_{j-1}, as in the model the Newton
-schemes solve (physics.model), so all schemes share the semi-discretisation. Measured
-on the linearisation of the semi-discrete model at the paper slip steady state
-(1000 elements graded 8, the default then): with the central term it is unstable, real
-parts up to +2.5/s with d = 39/s and +9/s with d = 0 (friction in the stick zone pumps the rotation modes), and
-a time-accurate scheme follows it and never settles (BDF2 at time_tol 1e-7 had not
-settled after 3 s on 300 elements; the default implicit run settles through BDF2's
-damping at its large steps). With the upwind term the slowest mode decays at 10/s with
-d = 39/s; with d = 0 it decays on coarse grids (4.8/s on 300 elements), while on
-1000 elements one mode still grows at +0.28/s, which a run reproduces (within 5% of the
-steady friction up to t_end). (These figures are of the first-order transport; with the
-three-point one the undamped run on 1000 elements still rings and grows, the same in this
-scheme and in BDF2 at time_tol 1e-7: total friction 204 N peak to peak over 0.1-0.2 s,
-249 N over 0.9-1.0 s, about +0.25/s, mean within 3 N of the steady 7124 N.) The central
-term, by a tridiagonal (Thomas) solve, was also stable by von Neumann but grew near its
-limit on bounded grids without damping.
+schemes solve (physics.model), so all schemes share the semi-discretisation. Measured on
+the linearisation of the semi-discrete model at the paper slip steady state (1000
+elements graded 8, the default then): with the central term it is unstable, real parts
+up to +2.5/s with d = 39/s and +9/s with d = 0 (friction in the stick zone pumps the
+rotation modes), and a time-accurate scheme follows it and never settles (BDF2 at
+time_tol 1e-7 had not settled after 3 s on 300 elements; the default implicit run
+settles through BDF2's damping at its large steps). With the upwind term the slowest
+mode decays at 10/s with d = 39/s; with d = 0 it decays on coarse grids (4.8/s on 300
+elements), while on 1000 elements one mode still grows at +0.28/s, which a run
+reproduces (within 5% of the steady friction up to t_end). (These figures are of the
+first-order transport; with the three-point one the undamped run on 1000 elements still
+rings and grows, the same in this scheme and in BDF2 at time_tol 1e-7: total friction
+204 N peak to peak over 0.1-0.2 s, 249 N over 0.9-1.0 s, about +0.25/s, mean within 3 N
+of the steady 7124 N.) The central term, by a tridiagonal (Thomas) solve, was also
+stable by von Neumann but grew near its limit on bounded grids without damping.
 
 Friction is implicit in each friction node's own velocity. Its slope f* / v_reg is
 enormous, so the velocity it sees must damp the friction relaxation (the mean of the
