@@ -126,11 +126,6 @@ class DiscreteSolution:
             value += li * fi
         return float(value)
 
-    def _stick_traction_at(self, p, xq):
-        """The stick traction extrapolated to xq from the FIT friction nodes before p
-        (quadratic; fewer near x1)."""
-        return self._extrapolate(self._stick_fit(p), xq)
-
     def _slip_front(self):
         """(x*, p): the slip start read inside the cell, and the node whose control volume
         holds it (None when no node slides).
@@ -225,7 +220,8 @@ class DiscreteSolution:
         """
         g = self.grid
         layer = np.arange(max(self.c0, g.j2 - LAYER + 1), g.j2 + 1)
-        smooth = np.array([self._stick_traction_at(layer[0], g.x[j]) for j in layer])
+        fit = self._stick_fit(layer[0])
+        smooth = np.array([self._extrapolate(fit, g.x[j]) for j in layer])
         return float(np.sum(self.fnode[layer] - smooth * self.wf[layer]))
 
     def summary(self, path: bool = False) -> dict:

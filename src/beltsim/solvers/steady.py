@@ -54,7 +54,7 @@ class SteadyScheme(NewtonScheme):
         """
         model = self.disc.model
         exact = is_exact(model.law)
-        smooth = regularised(model) if exact else model
+        smooth = regularised(model)  # the model itself for a regularised law
         try:
             if smooth.dual:
                 self.disc.model = smooth._replace(v_reg=REGULARISATION_START * smooth.v_reg)
