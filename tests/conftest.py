@@ -9,7 +9,12 @@ keeps its kernels in a cache directory of its own.
 """
 
 import os
+import sys
 import tempfile
+from pathlib import Path
+
+# the lab beside the package (benchmarks/, validation/) is imported from the checkout
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 if os.environ.get("NUMBA_BOUNDSCHECK", "0") not in ("", "0"):
     os.environ.setdefault("NUMBA_CACHE_DIR",

@@ -8,15 +8,15 @@ import scipy.sparse as sp
 from beltsim.physics import modes
 from beltsim.physics.model import State, residual_numpy
 from beltsim.problem.drive import Drive
-from beltsim.problem.scene import load_scene, runs_dir
+from beltsim.problem.scene import shipped_scene
 from beltsim.simulation import trackers
-from beltsim.studies import random_scenes as rs
+from validation import random_scenes as rs
 from beltsim.studies import stability
 from beltsim.studies.stability import ACCEPTED, Case, CellStatus, stability_cell
 
 
 def _slip(n, *over):
-    return load_scene(runs_dir() / "paper_slip.toml", [f"numerics.elements={n}", *over])
+    return shipped_scene("paper_slip", [f"numerics.elements={n}", *over])
 
 
 def _flutter(n):
@@ -137,7 +137,7 @@ def test_the_exact_law_linearises_like_its_regularised_twin():
     # the exact law's stuck nodes enter as the default regularisation's slope; the least
     # stable mode matches the tanh law's (measured on 200 elements: -19.3069 against
     # -19.3066 1/s, 121.28 Hz both)
-    base = load_scene(runs_dir() / "paper_slip.toml", ["numerics.elements=120"])
+    base = shipped_scene("paper_slip", ["numerics.elements=120"])
     reg = modes.growth_rate(base)
     exact = modes.growth_rate(base.with_overrides(['numerics.friction_law="exact"']))
     assert reg.rate < 0.0

@@ -10,7 +10,7 @@ import pytest
 
 from beltsim.problem.scene import load_scene
 from beltsim.simulation.controller import Simulation
-from beltsim.studies import port
+from benchmarks import port
 from helpers import scene_path
 
 

@@ -1,4 +1,4 @@
-"""`beltsim stability --random`: the draw is valid and reproducible, the CLI counts add up."""
+"""`python -m validation.random_scenes`: the draw is valid and reproducible, the CLI counts add up."""
 
 import csv
 import math
@@ -10,11 +10,11 @@ from hypothesis import strategies as st
 
 from beltsim import solvers
 from beltsim.problem import analytic
-from beltsim.problem.scene import Scene, load_scene, runs_dir
+from beltsim.problem.scene import Scene, shipped_scene
 from beltsim.solvers.settings import resolve
-from beltsim.studies import random_scenes as rs
+from validation import random_scenes as rs
 from beltsim.studies.stability import ACCEPTED, CellStatus
-from helpers import cli
+from helpers import module
 
 
 @settings(max_examples=300, deadline=None)
@@ -27,7 +27,7 @@ def test_every_drawn_scene_is_valid_and_runs_as_drawn(seed, index):
     assert again.to_dict() == scene.to_dict()
     # the stability case built from it (a shipped scene, every key overridden) is it
     case = rs.scene_case(scene)
-    assert load_scene(runs_dir() / f"{case.base}.toml", case.overrides).to_dict() == \
+    assert shipped_scene(case.base, case.overrides).to_dict() == \
         scene.to_dict()
     assert 0.0 < P.x1 < P.x2 < P.L and -1.0 < scene.to_dict()["beam"]["poisson_ratio"] < 0.5
     assert 1e-6 * (1 - 1e-6) <= abs(P.e0) <= 0.05 * (1 + 1e-6)
@@ -87,7 +87,7 @@ def test_a_few_random_scenes_through_the_cli(tmp_path):
     n, out = 4, tmp_path / "r"
     (out / "failures").mkdir(parents=True)
     (out / "failures" / "scene_99.toml").write_text("stale")  # a previous draw's
-    proc = cli("stability", "--random", n, "--seed", 3, "--elements", 60, "--out", out,
+    proc = module("validation.random_scenes", n, "--seed", 3, "--elements", 60, "--out", out,
                timeout=900)
     rows = list(csv.DictReader((out / "random.csv").open()))
     assert len(rows) == n * len(solvers.names())
@@ -125,7 +125,7 @@ def test_a_few_random_scenes_through_the_cli(tmp_path):
 
 
 def test_max_wall_skips_the_cells_not_started(tmp_path):
-    proc = cli("stability", "--random", 3, "--seed", 3, "--elements", 60, "--max-wall",
+    proc = module("validation.random_scenes", 3, "--seed", 3, "--elements", 60, "--max-wall",
                1e-9, "--out", tmp_path)
     rows = list(csv.DictReader((tmp_path / "random.csv").open()))
     assert proc.returncode == 0, proc.stderr
@@ -134,8 +134,8 @@ def test_max_wall_skips_the_cells_not_started(tmp_path):
 
 
 def test_bad_random_options_are_one_line_errors(tmp_path):
-    for args in (["--random", 0], ["--seed", 3], ["--random", 2, "--max-wall", -1]):
-        proc = cli("stability", *args, "--out", tmp_path)
+    for args in ([0], ["--seed", 3], [2, "--max-wall", -1]):
+        proc = module("validation.random_scenes", *args, "--out", tmp_path)
         assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
 
 
@@ -175,7 +175,7 @@ def test_an_undamped_scene_still_ringing_at_t_end_counts_as_bounded():
     scene cut as short is judged by its slowest mode instead (decaying at ~10 1/s it needs
     ~1.3 s, not the 0.003 s left after the ramp): bounded, stable but slow; a damped cell
     that could have settled stays a failure (tests/test_modes.py)."""
-    scene = load_scene(runs_dir() / "paper_slip.toml", ["numerics.elements=120"])
+    scene = shipped_scene("paper_slip", ["numerics.elements=120"])
     short = ("numerics.t_end=0.02",)
     undamped = rs.random_cell(scene.with_overrides(["physics.damping=0"]), 0, "implicit",
                               extra=short)

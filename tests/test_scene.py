@@ -185,3 +185,38 @@ def test_round_trip_through_toml():
     s = load_scene(scene_path("paper_slip"), ["numerics.elements=300"])
     again = Scene(tomllib.loads(s.to_toml()))
     assert again.to_dict() == s.to_dict()
+
+
+def test_shipped_scenes_load_by_name_and_match_their_files():
+    import beltsim
+    from helpers import scene_path
+    names = beltsim.scene_names()
+    assert {"paper_slip", "paper_inertia", "paper_quasistatic"} <= set(names)
+    for name in names:
+        assert (beltsim.load_scene(name).to_dict()
+                == beltsim.Scene.load(scene_path(name)).to_dict())
+    assert beltsim.paper_scene("slip").to_dict() == beltsim.load_scene("paper_slip").to_dict()
+    with pytest.raises(beltsim.SceneError, match="not one of the paper's scenes"):
+        beltsim.paper_scene("sliding")
+    with pytest.raises(beltsim.MissingInputError, match="no scene of that name"):
+        beltsim.load_scene("paper_slipp")
+
+
+def test_a_study_whose_scenes_are_missing_fails(tmp_path, monkeypatch, capsys):
+    """With the scene files hidden, the stability matrix stops with a one-line error and
+    a non-zero exit instead of counting every cell as refused."""
+    from beltsim.cli import main
+    from beltsim.problem import scene as scene_module
+    monkeypatch.setattr(scene_module, "_scenes_dir", lambda: tmp_path / "none")
+    assert main(["stability", "--elements", "60", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no scene of that name" in err
+    assert not (tmp_path / "o" / "stability.csv").exists()
+
+
+def test_the_cli_runs_a_shipped_scene_by_name(tmp_path):
+    from helpers import cli
+    proc = cli("run", "paper_quasistatic", "--set", "numerics.elements=60", "--quiet",
+               "--out", tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "summary.json").is_file() and "converged       true" in proc.stdout

@@ -7,8 +7,8 @@ checked against the bar's equations themselves (finite differences, not its form
 against its ODE by a separate integrator and against the exact steady solution, and
 then the simulation is shown to converge to it in the grid and in time.
 
-Scenes: the paper's (runs/paper_slip.toml, f* = 1e5 N/m, and
-runs/paper_quasistatic.toml, perfect adhesion), quasistatic, h = 1e-6 m, and
+Scenes: the paper's (the shipped paper_slip, f* = 1e5 N/m, and
+paper_quasistatic, perfect adhesion), quasistatic, h = 1e-6 m, and
 [stiffness] a = E w h^3/12, b1 = E w h, b2 = k E w h/(2 (1 + nu)) of the paper's
 h = 0.1 m. The history's checks are every 2^-11 s (about L/(17 c); the default L/(4c)
 gives only 8 checks in the ramp): binary, so fixed steps 2^-k end on every check.

@@ -3,23 +3,30 @@
 A few lines do what the CLI does::
 
     import beltsim
-    scene = beltsim.load_scene("runs/paper_slip.toml", ["contact.max_friction=2e5"])
+    scene = beltsim.load_scene("paper_slip", ["contact.max_friction=2e5"])
     exact = beltsim.solve(scene)            # analytic steady state
     result = beltsim.run(scene)             # transient, from rest to steady state
     print(result.summary()["error"])        # errors against the analytic solution
     beltsim.save_run(result, "runs/out/slip")
 """
 
-from .errors import BeltsimError, NoSolutionError, NumericalError, SceneError
+from .errors import (
+    BeltsimError,
+    MissingInputError,
+    NoSolutionError,
+    NumericalError,
+    SceneError,
+)
 from .io.results import save_run
 from .problem.analytic import AnalyticSolution, solve
-from .problem.scene import Scene, load_scene
+from .problem.scene import Scene, load_scene, paper_scene, scene_names, shipped_scene
 from .simulation.controller import Simulation, run
 from .simulation.result import RunResult, RunStatus
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "AnalyticSolution", "BeltsimError", "NoSolutionError", "NumericalError", "RunResult",
-    "RunStatus", "Scene", "SceneError", "Simulation", "load_scene", "run", "save_run", "solve",
+    "AnalyticSolution", "BeltsimError", "MissingInputError", "NoSolutionError",
+    "NumericalError", "RunResult", "RunStatus", "Scene", "SceneError", "Simulation",
+    "load_scene", "paper_scene", "run", "save_run", "scene_names", "shipped_scene", "solve",
 ]

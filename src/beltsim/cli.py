@@ -12,13 +12,16 @@ import sys
 from .errors import BeltsimError, NumericalError, UsageError
 
 
-class _Parser(argparse.ArgumentParser):
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line on stderr and exit status 2."""
+
     def error(self, message):  # one line, exit 2, as for a bad scene
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
 def _add_scene_args(p, **scene_kw):
-    p.add_argument("scene", **({"help": "scene file (TOML)"} | scene_kw))
+    p.add_argument("scene", **({"help": "scene file (TOML) or the name of a shipped scene "
+                                          "(paper_slip, ...)"} | scene_kw))
     p.add_argument("--set", dest="overrides", action="append", default=[],
                    metavar="SECTION.KEY=VALUE", help="override a scene key (repeatable)")
 
@@ -168,69 +171,16 @@ def cmd_convergence(args):
 def cmd_bench(args):
     if args.repeat < 1:
         raise UsageError(f"--repeat: must be at least 1, got {args.repeat}")
-    if not args.peer_cap > 0:
-        raise UsageError(f"--peer-cap: must be positive, got {args.peer_cap}")
+    from .problem.scene import load_scene
     from .studies import bench as studies
 
-    result = studies.bench(args.scene, args.overrides, peer=not args.no_peer,
-                           cold=not args.no_cold, elements=args.elements, repeat=args.repeat,
-                           peer_cap=args.peer_cap, search=args.search_rtol,
-                           port=not args.no_port)
+    overrides = list(args.overrides)
+    if args.elements is not None:
+        overrides.append(f"numerics.elements={args.elements}")
+    scene = load_scene(args.scene, overrides)
+    result = studies.bench(scene, cold=not args.no_cold, repeat=args.repeat)
     print(studies.bench_json(result))
     return 0
-
-
-def _stability_random(args):
-    import time
-    from pathlib import Path
-
-    from .io.files import prepare_outdir, write_atomic, write_csv
-    from .studies import random_scenes as studies
-
-    if args.random < 1:
-        raise UsageError(f"--random: must be >= 1 scene, got {args.random}")
-    if args.max_wall is not None and not args.max_wall > 0:
-        raise UsageError(f"--max-wall: must be > 0 s, got {args.max_wall}")
-    if args.jobs is not None and args.jobs < 1:
-        raise UsageError(f"--jobs: must be >= 1, got {args.jobs}")
-    seed = 0 if args.seed is None else args.seed
-    out = prepare_outdir(args.out or Path("runs/out/stability_random"))
-    failures = out / "failures"
-    for old in failures.glob("scene_*.toml"):  # a previous draw's: they would pass as ours
-        old.unlink()
-    extra = [f"numerics.elements={args.elements}"] if args.elements else []
-
-    def show(row):
-        print(f"scene {row['index']:<5d} {row['scheme']:<9s} {row['status']:<15s} "
-              f"{row['elements']:>7d} el {row['elapsed']:8.3g} s  {row['reason'][:80]}",
-              flush=True)
-
-    def keep(scene, rows):  # at each failed cell: a killed run still leaves the scenes
-        prepare_outdir(failures)
-        write_atomic(failures / f"scene_{rows[0]['index']}.toml",
-                     studies.failure_scene(scene, rows, extra).to_toml())
-    start = time.perf_counter()
-    rows = studies.random_study(args.random, seed, extra=extra, max_wall=args.max_wall,
-                                progress=show, on_failure=keep, jobs=args.jobs or 1)
-    wall = time.perf_counter() - start
-    write_csv(out / "random.csv", studies.COLUMNS,
-              [[r[c] for r in rows] for c in studies.COLUMNS],
-              text_columns=studies.TEXT_COLUMNS)
-    write_atomic(out / "random.md",
-                 studies.random_markdown(rows, seed, args.random, wall, extra))
-    counts = studies.counts(rows)
-    print(f"{args.random} scenes (seed {seed}), {len(rows)} cells in {wall:.0f} s: "
-          + ", ".join(f"{k} {n}" for k, n in sorted(counts["status"].items())))
-    for (status, key), n in sorted(counts["reason"].items(), key=lambda kv: -kv[1]):
-        print(f"  {status:<15s} {n:5d}  {key}")
-    bad = [r for r in rows if studies.failed(r)]
-    print(f"wrote {out / 'random.csv'} and {out / 'random.md'}"
-          + (f"; {len(bad)} failed cells, their scenes in {failures}" if bad else ""))
-    if any(r["reason"] == studies.INTERRUPTED for r in rows):
-        print("beltsim: interrupted (the cells not run are reported as skipped)",
-              file=sys.stderr)
-        return 130
-    return 1 if bad else 0
 
 
 def cmd_stability(args):
@@ -240,10 +190,6 @@ def cmd_stability(args):
     from .studies import stability as studies
     from .studies.convergence import ERROR_KEYS
 
-    if args.random is not None:
-        return _stability_random(args)
-    if args.seed is not None or args.max_wall is not None or args.jobs is not None:
-        raise UsageError("--seed, --max-wall and --jobs go with --random N")
     out = prepare_outdir(args.out or Path("runs/out/stability"))
     extra = [f"numerics.elements={args.elements}"] if args.elements else []
     cases = studies.STABILITY_CASES
@@ -390,9 +336,9 @@ def _cell(v):
 
 
 def build_parser():
-    parser = _Parser(prog="beltsim", description="Belt-drive contact mechanics: analytic "
+    parser = OneLineParser(prog="beltsim", description="Belt-drive contact mechanics: analytic "
                      "steady solutions and transient Eulerian simulation.")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
     p = sub.add_parser("analytic", help="analytic steady solution of a scene")
     _add_scene_args(p)
     p.add_argument("--out", default="runs/out/analytic", help="output directory")
@@ -463,36 +409,17 @@ def build_parser():
     p.add_argument("--out", default=None, help="output directory")
     p.add_argument("--elements", type=int, default=None,
                    help="run every case on this many elements (a quick, coarse matrix)")
-    p.add_argument("--random", type=int, default=None, metavar="N",
-                   help="instead of the matrix: N random valid scenes, each by every "
-                   "applicable scheme (random.csv, random.md, failures/scene_<i>.toml)")
-    p.add_argument("--seed", type=int, default=None, metavar="S",
-                   help="with --random: the draw (default 0); scene i of seed S is always "
-                   "the same scene")
-    p.add_argument("--max-wall", type=float, default=None, metavar="SECONDS",
-                   help="with --random: start no cell after this many seconds (the rest "
-                   "are reported as skipped)")
-    p.add_argument("--jobs", type=int, default=None, metavar="N",
-                   help="with --random: run the cells in N processes (default 1); the rows "
-                   "and counts are the same, only the wall times differ")
     p.set_defaults(func=cmd_stability)
 
-    p = sub.add_parser("bench", help="paper slip scene: ours against generic scipy peers "
-                       "(Radau, BDF, sparse Newton), explicit kernel speed, cold start")
-    _add_scene_args(p, nargs="?", default="runs/paper_slip.toml",
-                    help="scene file (TOML; default runs/paper_slip.toml)")
+    p = sub.add_parser("bench", help="wall times of the default and steady runs, the explicit "
+                       "kernel's speed and a cold start (peers: benchmarks/ of the repository)")
+    _add_scene_args(p, nargs="?", default="paper_slip",
+                    help="scene file or shipped scene name (default paper_slip)")
     p.add_argument("--elements", type=int, default=None,
                    help="number of elements (numerics.elements; default the scene's)")
     p.add_argument("--repeat", type=int, default=3,
                    help="time each run this many times and keep the shortest (default 3)")
-    p.add_argument("--peer-cap", type=float, default=600.0,
-                   help="wall-time cap of one transient peer run, s (default 600)")
-    p.add_argument("--search-rtol", action="store_true",
-                   help="first find each transient peer's loosest rtol on this grid")
-    p.add_argument("--no-peer", action="store_true", help="skip the peers")
     p.add_argument("--no-cold", action="store_true", help="skip the cold-start run")
-    p.add_argument("--no-port", action="store_true",
-                   help="skip the numpy/scipy.sparse port of the default scheme")
     p.set_defaults(func=cmd_bench)
     return parser
 

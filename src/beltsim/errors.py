@@ -28,3 +28,8 @@ class NumericalError(BeltsimError, RuntimeError):
 
 class UsageError(BeltsimError, ValueError):
     """A command-line option has a bad value."""
+
+
+class MissingInputError(BeltsimError, FileNotFoundError):
+    """An input a command or study needs is not installed or not found (a shipped scene,
+    a run directory's file); a study never counts a missing input as a pass."""

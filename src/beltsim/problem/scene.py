@@ -14,7 +14,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import SceneError
+from ..errors import MissingInputError, SceneError
 
 # ---------------------------------------------------------------------------
 # Schema
@@ -445,6 +445,7 @@ class Scene:
     # construction -----------------------------------------------------
     @classmethod
     def load(cls, path) -> "Scene":
+        """Read and validate a scene file (TOML)."""
         path = Path(path)
         try:
             text = path.read_bytes()
@@ -455,12 +456,19 @@ class Scene:
         except OSError as exc:
             raise SceneError(f"{path}: cannot read scene file ({exc.strerror})") from None
         try:
-            data = tomllib.loads(text.decode("utf-8"))
+            text = text.decode("utf-8")
         except UnicodeDecodeError:
             raise SceneError(f"{path}: not a UTF-8 text file") from None
+        return cls.loads(text, source=str(path))
+
+    @classmethod
+    def loads(cls, text: str, source: str | None = None) -> "Scene":
+        """Parse and validate a scene from TOML text."""
+        try:
+            data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
-            raise SceneError(f"{path}: malformed TOML ({exc})") from None
-        return cls(data, source=str(path))
+            raise SceneError(f"{source or 'scene'}: malformed TOML ({exc})") from None
+        return cls(data, source=source)
 
     @classmethod
     def from_dict(cls, data: dict) -> "Scene":
@@ -562,28 +570,54 @@ def set_key(data: dict, key: str, value) -> None:
     data.setdefault(section, {})[name] = value
 
 
-def load_scene(path, overrides=()) -> Scene:
-    """Load a scene file and apply ``SECTION.KEY=VALUE`` overrides."""
-    scene = Scene.load(path)
+def scene_names() -> tuple[str, ...]:
+    """The names of the scenes shipped with beltsim (``beltsim run NAME`` runs one)."""
+    return tuple(sorted(f.name[:-5] for f in _scenes_dir().iterdir()
+                        if f.name.endswith(".toml")))
+
+
+def _scenes_dir():
+    from importlib.resources import files
+
+    return files("beltsim") / "scenes"
+
+
+def shipped_scene(name: str, overrides=()) -> Scene:
+    """A scene shipped with beltsim, by name (see :func:`scene_names`).
+
+    Raises :class:`~beltsim.errors.MissingInputError` when the package holds no such
+    scene (an installation without its scene files included).
+    """
+    resource = _scenes_dir() / f"{name}.toml"
+    if not resource.is_file():
+        known = ", ".join(scene_names()) if _scenes_dir().is_dir() else "none installed"
+        raise MissingInputError(f"{name}: no scene of that name ships with beltsim "
+                                f"(shipped: {known})")
+    scene = Scene.loads(resource.read_text(encoding="utf-8"), source=name)
     return scene.with_overrides(overrides) if overrides else scene
 
 
-def runs_dir() -> Path:
-    """The repository's runs/ folder (scene files), from the working directory or the package.
+def load_scene(path_or_name, overrides=()) -> Scene:
+    """A scene from a TOML file, or a shipped scene by name, with ``SECTION.KEY=VALUE``
+    overrides applied.
 
-    The paper's scenes ship in runs/ of a source checkout (the package is installed
-    from it in editable mode).
+    A name without a path separator or suffix (``"paper_slip"``) that is not an existing
+    file is looked up among the shipped scenes (:func:`scene_names`).
     """
-    candidates = [Path.cwd() / "runs"]
-    here = Path(__file__).resolve()
-    candidates += [p / "runs" for p in here.parents]
-    for c in candidates:
-        if (c / "paper_slip.toml").is_file():
-            return c
-    raise SceneError("runs/: the paper's scene files were not found (run from a beltsim "
-                     "source checkout)")
+    text = str(path_or_name)
+    if not Path(text).exists() and "/" not in text and "\\" not in text \
+            and not text.endswith(".toml"):
+        return shipped_scene(text, overrides)
+    scene = Scene.load(path_or_name)
+    return scene.with_overrides(overrides) if overrides else scene
+
+
+#: The paper's three scenes, by the short name :func:`paper_scene` takes.
+PAPER_SCENES = ("quasistatic", "inertia", "slip")
 
 
 def paper_scene(name: str, overrides=()) -> Scene:
     """One of the paper's scenes: "quasistatic", "inertia" or "slip"."""
-    return load_scene(runs_dir() / f"paper_{name}.toml", overrides)
+    if name not in PAPER_SCENES:
+        raise SceneError(f"{name}: not one of the paper's scenes ({', '.join(PAPER_SCENES)})")
+    return shipped_scene(f"paper_{name}", overrides)

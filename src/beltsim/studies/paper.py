@@ -2,7 +2,7 @@
 
 Cases: "quasistatic" (no inertia, perfect adhesion), "inertia" (inertia, perfect
 adhesion) and "slip" (inertia, stick and slip, f* = 1e5 N/m), the scenes
-runs/paper_*.toml. The figures are drawn by :mod:`beltsim.plots.paper`.
+the shipped scenes paper_*.toml. The figures are drawn by :mod:`beltsim.plots.paper`.
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from .. import solvers
 from ..errors import BeltsimError
-from ..problem.scene import load_scene, runs_dir
+from ..problem.scene import shipped_scene
 from ..simulation.controller import Simulation
 from ..simulation.result import RunStatus, reference_of
 from .convergence import ERROR_KEYS
@@ -54,7 +54,7 @@ _RUN_STATUS = {RunStatus.FAILED: CellStatus.DIVERGED, RunStatus.REACHED_END:
 @dataclass(frozen=True)
 class Case:
     name: str
-    base: str  # a scene of runs/
+    base: str  # a shipped scene (problem.scene.scene_names)
     overrides: tuple[str, ...] = ()
     #: run over this span of simulated time and ask only that the state stay bounded
     #: (an undamped belt rings for long, a fluttering one grows into a limit cycle; no
@@ -118,8 +118,9 @@ def stability_cell(case: Case, scheme: str, extra=()) -> dict:
     cell = {"scheme": scheme, "status": "", "reason": "", "dt": float("nan"), "steps": 0,
             "wall_time": float("nan"), **{f"error_{k}": float("nan") for k in ERROR_KEYS}}
     span = [f"numerics.t_end={case.span}"] if case.span else []
+    base = shipped_scene(case.base)  # a missing base scene fails the study, not the cell
     try:
-        scene = load_scene(runs_dir() / f"{case.base}.toml", [*case.overrides, *span, *extra])
+        scene = base.with_overrides([*case.overrides, *span, *extra])
     except BeltsimError as exc:
         cell.update(status=CellStatus.REFUSED, reason=str(exc))
         return cell

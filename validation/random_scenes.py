@@ -1,6 +1,6 @@
 """Random scenes across the whole parameter space, each by every applicable scheme.
 
-`beltsim stability --random N --seed S` draws N valid scenes and runs each with every
+`python -m validation.random_scenes N --seed S` draws N valid scenes and runs each with every
 registered scheme at its default grid. A cell is judged exactly as in the stability
 matrix (:func:`beltsim.studies.stability.stability_cell`, its statuses, ACCEPTED and
 BOUNDS): each drawn scene becomes a :class:`~beltsim.studies.stability.Case` whose
@@ -41,11 +41,11 @@ from collections import Counter
 
 import numpy as np
 
-from .. import solvers
-from ..errors import BeltsimError
-from ..problem.scene import Scene
-from .convergence import ERROR_KEYS
-from .stability import ACCEPTED, BOUNDS, Case, CellStatus, stability_cell
+from beltsim import solvers
+from beltsim.errors import BeltsimError
+from beltsim.problem.scene import Scene
+from beltsim.studies.convergence import ERROR_KEYS
+from beltsim.studies.stability import ACCEPTED, BOUNDS, Case, CellStatus, stability_cell
 
 SKIPPED = "skipped"  # not started: the run's --max-wall was spent
 CRASHED = "crashed"  # an exception that is not one of beltsim's own errors (a bug)
@@ -58,7 +58,7 @@ SCENE_KEYS = {
     "physics": ("inertia", "damping"),
 }
 PAPER_ELEMENTS = 1000  # the grid of the paper scenes (L = 1 m) that BOUNDS were set on
-_BASE = {"stick": "paper_inertia", "coulomb": "paper_slip"}  # runs/ scenes with these keys
+_BASE = {"stick": "paper_inertia", "coulomb": "paper_slip"}  # shipped scenes with these keys
 #: Columns of random.csv.
 COLUMNS = ("index", "scheme", "status", "reason_key", "friction", "inertia", "damping",
            "mismatch", "speed_ratio", "elements", "dt", "steps", "wall_time",
@@ -178,7 +178,7 @@ def ringing_span(scene: Scene, scheme: str, extra=()) -> list[str]:
     """The overrides that shorten an undamped scene's time-accurate run (RINGING_TRANSITS),
     with the explicit scheme's max_work scaled alike, so that it refuses the cells it
     would refuse over the default span."""
-    from ..solvers.settings import DEFAULT_MAX_WORK, resolve
+    from beltsim.solvers.settings import DEFAULT_MAX_WORK, resolve
 
     P = scene.params
     if not (P.inertia and P.damping == 0.0 and solvers.get(scheme).time_accurate):
@@ -254,7 +254,7 @@ def describe(scene: Scene, extra=()) -> dict:
 
 
 def _elements(scene, extra) -> int:
-    from ..solvers.settings import default_elements
+    from beltsim.solvers.settings import default_elements
     for item in extra:
         if item.startswith("numerics.elements="):
             return int(item.split("=", 1)[1])
@@ -442,3 +442,78 @@ def random_markdown(rows, seed: int, n: int, wall: float, extra=()) -> str:
             lines.append(f"| {r['index']} | {r['scheme']} | {r['status']} | {r['elements']} "
                          f"| {r['elapsed']:.3g} | {r['reason'].replace('|', '/')} |")
     return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    """``python -m validation.random_scenes N [--seed S] [--elements E] [--max-wall SECONDS]
+    [--jobs J] [--out DIR]``: N random scenes, each by every applicable scheme.
+
+    Exit status 0 when every cell passed, 1 when a cell failed (its scene is written to
+    ``failures/``), 2 on bad options, 130 interrupted.
+    """
+    import sys
+    from pathlib import Path
+
+    from beltsim.cli import OneLineParser
+    from beltsim.io.files import prepare_outdir, write_atomic, write_csv
+
+    parser = OneLineParser(
+        prog="python -m validation.random_scenes",
+        description="Random valid scenes, each by every applicable scheme (random.csv, "
+                    "random.md, failures/scene_<i>.toml).")
+    parser.add_argument("n", type=int, metavar="N", help="number of scenes (>= 1)")
+    parser.add_argument("--seed", type=int, default=0, metavar="S",
+                        help="the draw (default 0); scene i of seed S is always the same")
+    parser.add_argument("--elements", type=int, default=None,
+                        help="run every scene on this many elements")
+    parser.add_argument("--max-wall", type=float, default=None, metavar="SECONDS",
+                        help="start no cell after this many seconds (the rest are skipped)")
+    parser.add_argument("--jobs", type=int, default=1, metavar="J",
+                        help="run the cells in J processes (default 1); the rows and counts "
+                             "are the same, only the wall times differ")
+    parser.add_argument("--out", default="runs/out/stability_random", help="output directory")
+    args = parser.parse_args(argv)
+    if args.n < 1:
+        parser.error(f"N: must be >= 1 scene, got {args.n}")
+    if args.max_wall is not None and not args.max_wall > 0:
+        parser.error(f"--max-wall: must be > 0 s, got {args.max_wall}")
+    if args.jobs < 1:
+        parser.error(f"--jobs: must be >= 1, got {args.jobs}")
+    out = prepare_outdir(Path(args.out))
+    failures = out / "failures"
+    for old in failures.glob("scene_*.toml"):  # a previous draw's: they would pass as ours
+        old.unlink()
+    extra = [f"numerics.elements={args.elements}"] if args.elements else []
+
+    def show(row):
+        print(f"scene {row['index']:<5d} {row['scheme']:<9s} {row['status']:<15s} "
+              f"{row['elements']:>7d} el {row['elapsed']:8.3g} s  {row['reason'][:80]}",
+              flush=True)
+
+    def keep(scene, rows):  # at each failed cell: a killed run still leaves the scenes
+        prepare_outdir(failures)
+        write_atomic(failures / f"scene_{rows[0]['index']}.toml",
+                     failure_scene(scene, rows, extra).to_toml())
+    start = time.perf_counter()
+    rows = random_study(args.n, args.seed, extra=extra, max_wall=args.max_wall,
+                        progress=show, on_failure=keep, jobs=args.jobs)
+    wall = time.perf_counter() - start
+    write_csv(out / "random.csv", COLUMNS, [[r[c] for r in rows] for c in COLUMNS],
+              text_columns=TEXT_COLUMNS)
+    write_atomic(out / "random.md", random_markdown(rows, args.seed, args.n, wall, extra))
+    tally = counts(rows)
+    print(f"{args.n} scenes (seed {args.seed}), {len(rows)} cells in {wall:.0f} s: "
+          + ", ".join(f"{k} {n}" for k, n in sorted(tally["status"].items())))
+    for (status, key), n in sorted(tally["reason"].items(), key=lambda kv: -kv[1]):
+        print(f"  {status:<15s} {n:5d}  {key}")
+    bad = [r for r in rows if failed(r)]
+    print(f"wrote {out / 'random.csv'} and {out / 'random.md'}"
+          + (f"; {len(bad)} failed cells, their scenes in {failures}" if bad else ""))
+    if any(r["reason"] == INTERRUPTED for r in rows):
+        print("interrupted (the cells not run are reported as skipped)", file=sys.stderr)
+        return 130
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -28,12 +28,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import SceneError
-from ..physics.friction import is_exact, law_numpy
-from ..physics.model import forces_numpy, strain_numpy
-from ..problem.drive import Drive, friction_factor, mismatch
-from ..simulation.controller import Simulation
-from ..solvers.newton import ROUNDOFF_FLOOR
+from beltsim.errors import SceneError
+from beltsim.physics.friction import is_exact, law_numpy
+from beltsim.physics.model import forces_numpy, strain_numpy
+from beltsim.problem.drive import Drive, friction_factor, mismatch
+from beltsim.simulation.controller import Simulation
+from beltsim.solvers.newton import ROUNDOFF_FLOOR
 
 #: The loosest rtol of RTOL_LADDER with which each transient peer reached beltsim's
 #: steady state on the paper slip scene, 250 elements (``beltsim bench --elements 250

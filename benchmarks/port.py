@@ -35,13 +35,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import NumericalError
-from ..physics.friction import SQRT, TANH, law_inverse_numpy, law_numpy
-from ..physics.model import LAM_MAX, POWER_TERMS, strain_numpy
-from ..problem.drive import friction_factor, mismatch
-from ..simulation.controller import Simulation
-from ..solvers.base import Scheme
-from ..solvers.implicit import (
+from beltsim.errors import NumericalError
+from beltsim.physics.friction import SQRT, TANH, law_inverse_numpy, law_numpy
+from beltsim.physics.model import LAM_MAX, POWER_TERMS, strain_numpy
+from beltsim.problem.drive import friction_factor, mismatch
+from beltsim.simulation.controller import Simulation
+from beltsim.solvers.base import Scheme
+from beltsim.solvers.implicit import (
     BDF2_ERROR,
     MAX_GROWTH,
     MIN_SHRINK,
@@ -49,7 +49,7 @@ from ..solvers.implicit import (
     SAFETY,
     ImplicitScheme,
 )
-from ..solvers.newton import CONTRACTION, LAW_GAP, NEAR_BOUND, ROUNDOFF_FLOOR
+from beltsim.solvers.newton import CONTRACTION, LAW_GAP, NEAR_BOUND, ROUNDOFF_FLOOR
 
 
 class BandPattern:
