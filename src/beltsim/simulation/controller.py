@@ -33,6 +33,7 @@ from .trackers import (
     SignalTracker,
     SnapshotTracker,
     SteadyStateTracker,
+    Stop,
     Tracker,
 )
 
@@ -43,7 +44,30 @@ CHECKS_PER_PERIOD = 32  # at least, for a periodic drive (its extremes are read 
 class Simulation:
     """A scene on its grid, from rest, with the scheme its numerics name.
 
-    ``run()`` steps it to steady state (or t_end) and returns a :class:`RunResult`.
+    :meth:`run` steps it to steady state (or t_end) and returns a :class:`RunResult`;
+    :func:`beltsim.run` does both and attaches the exact steady solution.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    grid : Grid, optional
+        A grid of its own (default: the one the scene's numerics describe).
+    snapshot_interval : float, optional
+        Store the state every so many seconds of simulated time (default the scene's
+        ``numerics.snapshot_interval``; none without it).
+    loads : beltsim.physics.model.Loads, optional
+        Distributed loads on this grid.
+
+    Raises
+    ------
+    SceneError
+        Numerical settings the scene's scheme refuses.
+
+    Examples
+    --------
+    >>> sim = beltsim.Simulation(beltsim.paper_scene("slip"))      # doctest: +SKIP
+    >>> result = sim.run(trackers=[MyTracker()])                   # doctest: +SKIP
     """
 
     def __init__(self, scene: Scene, grid: Grid | None = None,
@@ -135,13 +159,19 @@ class Simulation:
         self._measured = None
 
     def trackers(self, progress=False, handle_signals=False, callback=None,
-                 checkpoint=None) -> list[Tracker]:
-        """The trackers of a run, in the order they handle each check."""
+                 checkpoint=None, extra=()) -> list[Tracker]:
+        """The trackers of a run, in the order they handle each check.
+
+        The divergence guard first, then the records (history, power, snapshots), the
+        user's ``extra`` trackers, the progress bar, the steady-state test, and the
+        stop requests (callback, signals) and the checkpoint last.
+        """
         out: list[Tracker] = [DivergenceGuard(), self.history]
         if self.power is not None:
             out.append(self.power)
         if self.snapshots is not None:
             out.append(self.snapshots)
+        out.extend(extra)
         if progress:
             out.append(ProgressTracker())
         out.append(self.steady)
@@ -154,19 +184,48 @@ class Simulation:
         return out
 
     def run(self, progress: bool = False, raise_on_failure: bool = True,
-            handle_signals: bool = False, callback=None, checkpoint=None) -> RunResult:
+            handle_signals: bool = False, callback=None, checkpoint=None,
+            trackers=()) -> RunResult:
         """Run from the current state until steady (or t_end).
 
-        With ``handle_signals`` (the CLI), SIGINT and SIGTERM stop the run cleanly
-        between chunks (status INTERRUPTED); ``checkpoint`` is a path where an
-        interrupted or failed run stores what :meth:`resume` needs. ``callback(sim)`` is
-        called after every chunk; a true return value stops the run the same way. The
-        analytic reference is not attached: :func:`beltsim.run` does that.
+        The analytic reference is not attached: :func:`beltsim.run` does that.
+
+        Parameters
+        ----------
+        progress : bool, optional
+            Show a progress bar (``tqdm.auto``: a widget in Jupyter, text elsewhere).
+        raise_on_failure : bool, optional
+            Raise :class:`~beltsim.errors.NumericalError` on a numerical failure; when
+            False, return a result with status FAILED and the last good state.
+        handle_signals : bool, optional
+            SIGINT and SIGTERM stop the run cleanly between chunks (status
+            INTERRUPTED), as in the CLI.
+        callback : callable, optional
+            ``callback(sim)`` after every chunk; a true return value stops the run
+            (status INTERRUPTED).
+        checkpoint : str or Path, optional
+            Where an interrupted or failed run stores what :meth:`resume` needs.
+        trackers : sequence of Tracker, optional
+            The user's own trackers (:class:`beltsim.Tracker` subclasses), called at
+            every check after the run's records and before its steady-state test.
+
+        Returns
+        -------
+        RunResult
+
+        Raises
+        ------
+        NumericalError
+            On a numerical failure, with ``raise_on_failure``.
+        TypeError
+            A tracker that is not a :class:`beltsim.Tracker`, or a ``handle`` that
+            returns something other than None or a :class:`Stop`.
         """
+        trackers = _user_trackers(trackers)
         compile_time = self.warm_up()
         if not self.scheme.transient:
-            return self._run_steady(raise_on_failure, compile_time)
-        trackers = self.trackers(progress, handle_signals, callback, checkpoint)
+            return self._run_steady(raise_on_failure, compile_time, trackers)
+        trackers = self.trackers(progress, handle_signals, callback, checkpoint, trackers)
         for tr in trackers:
             tr.initialize(self)
         t_end = self.numerics.t_end
@@ -195,7 +254,7 @@ class Simulation:
                     self._restore(good)
                     raise
                 if stop is not None:
-                    status, reason = stop.status, stop.reason
+                    status, reason = _stop_of(tr, stop, self.t)
                     break
         except NumericalError as exc:
             status, reason = RunStatus.FAILED, str(exc)
@@ -216,7 +275,10 @@ class Simulation:
         self.scheme.restore(scheme)
         self._measured = None
 
-    def _run_steady(self, raise_on_failure, compile_time):
+    def _run_steady(self, raise_on_failure, compile_time, trackers=()):
+        # a steady solve makes no checks: its trackers start and end around it
+        for tr in trackers:
+            tr.initialize(self)
         start = time.perf_counter()
         status, reason = RunStatus.CONVERGED, None
         try:
@@ -228,6 +290,8 @@ class Simulation:
         finally:
             self.wall_time = time.perf_counter() - start
             self._measured = None
+            for tr in trackers:
+                tr.finalize(self, status)
         return self._result(status, reason, compile_time)
 
     def _result(self, status, reason, compile_time) -> RunResult:
@@ -253,7 +317,7 @@ class Simulation:
         return out
 
     @classmethod
-    def resume(cls, path) -> "Simulation":
+    def resume(cls, path) -> Simulation:
         """A simulation restored from a checkpoint (:func:`beltsim.io.results.write_checkpoint`)."""
         from ..io.results import read_checkpoint
 
@@ -273,12 +337,66 @@ class Simulation:
         return sim
 
 
+def _user_trackers(trackers) -> list[Tracker]:
+    """The user's trackers as a list, each checked to be a Tracker."""
+    out = list(trackers or ())
+    for tr in out:
+        if not isinstance(tr, Tracker):
+            raise TypeError(f"trackers: each must be a beltsim.Tracker (a subclass with "
+                            f"initialize, handle, finalize), got {tr!r}")
+    return out
+
+
+def _stop_of(tracker: Tracker, stop, t: float):
+    """The status and reason of the run a tracker's ``handle`` stopped at time t."""
+    if not isinstance(stop, Stop):
+        raise TypeError(f"{type(tracker).__name__}.handle: must return None or a "
+                        f"beltsim.Stop, got {stop!r}")
+    reason = stop.reason
+    if reason is None and stop.status is not RunStatus.CONVERGED:
+        reason = f"stopped by {type(tracker).__name__} at t = {t:.6g} s"
+    return stop.status, reason
+
+
 def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,
-        snapshot_interval: float | None = None) -> RunResult:
-    """Run a scene from rest to steady state and attach its exact steady solution."""
+        snapshot_interval: float | None = None, trackers=()) -> RunResult:
+    """Run a scene from rest to steady state and attach its exact steady solution.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene; its ``numerics`` choose the scheme and the grid.
+    progress : bool, optional
+        Show a progress bar (``tqdm.auto``: a widget in Jupyter, text elsewhere).
+    raise_on_failure : bool, optional
+        Raise on a numerical failure (default); when False, return a result with
+        status FAILED holding the last good state.
+    snapshot_interval : float, optional
+        Store the state every so many seconds of simulated time
+        (``result.snapshots``); default the scene's ``numerics.snapshot_interval``.
+    trackers : sequence of Tracker, optional
+        The user's own trackers (:class:`beltsim.Tracker`), called at every check.
+
+    Returns
+    -------
+    RunResult
+        With ``reference``, the exact steady solution, where the scene has one.
+
+    Raises
+    ------
+    NumericalError
+        On a numerical failure, with ``raise_on_failure``.
+    SceneError
+        Numerical settings the scene's scheme refuses.
+
+    Examples
+    --------
+    >>> result = beltsim.run(beltsim.paper_scene("slip"), progress=True)  # doctest: +SKIP
+    >>> result.converged, result.errors()["total_friction"]              # doctest: +SKIP
+    """
     from .result import reference_of
 
     result = Simulation(scene, snapshot_interval=snapshot_interval).run(
-        progress=progress, raise_on_failure=raise_on_failure)
+        progress=progress, raise_on_failure=raise_on_failure, trackers=trackers)
     result.reference = reference_of(scene)
     return result

@@ -5,6 +5,8 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ..problem import analytic
 from ..problem.drive import period_of
 from ..problem.scene import Scene
@@ -13,6 +15,8 @@ from .solution import DiscreteSolution, compare
 
 
 class RunStatus(enum.Enum):
+    """How a run ended (``RunResult.status``)."""
+
     CONVERGED = "converged"  # steady state reached
     REACHED_END = "reached t_end"  # t_end reached before steady state
     FAILED = "failed"  # stopped on a numerical failure; the state is the last good one
@@ -21,6 +25,51 @@ class RunStatus(enum.Enum):
 
 @dataclass
 class RunResult:
+    """A run's outcome: how it ended, its final state, its history.
+
+    The final state reads as arrays over the grid (:attr:`x`, :attr:`fields`), the
+    checks as arrays over time (:attr:`history`), the numbers the analytic solution
+    also gives in :meth:`summary`, and the errors against it in :meth:`errors`.
+
+    Attributes
+    ----------
+    scene : Scene
+        The scene that ran.
+    numerics : beltsim.solvers.settings.Numerics
+        The settings it ran with, every default resolved.
+    status : RunStatus
+        How it ended.
+    reason : str or None
+        Why it stopped, when not steady.
+    time_accurate : bool
+        The scheme follows the scene's path in time, not only to its end.
+    solution : DiscreteSolution
+        The final state, read as a solution (totals, slip start, concentrated force).
+    simulated_time, wall_time, compile_time : float
+        Seconds: simulated, of stepping, of compiling (or loading) the kernels.
+    statistics : dict
+        The scheme's counters: ``steps`` and, where it has them, ``rejected_steps``,
+        ``newton_iterations``.
+    history : dict of str to numpy.ndarray
+        One value per check: ``t`` (s), ``total_friction`` (N), ``rate`` and, for a
+        coulomb scene, ``slip_start`` (m), ``stick_friction``, ``slip_friction`` (N)
+        and ``slip_power`` (W), or for perfect adhesion ``concentrated_force`` (N).
+    snapshots : dict of str to numpy.ndarray
+        ``t`` and the states ``u``, ``theta``, ``fnode`` (times, nodes) at every
+        snapshot interval (empty unless asked for).
+    power_balance : dict or None
+        The energy balance over the run (schemes that integrate the power terms).
+    periodic : dict or None
+        A periodic drive's last period: extremes and means of the history.
+    reference : AnalyticSolution or None
+        The exact steady solution of the scene, where :func:`beltsim.run` attached it.
+
+    Examples
+    --------
+    >>> result = beltsim.run(beltsim.paper_scene("slip"))          # doctest: +SKIP
+    >>> result.fields["u"].max(), result.history["total_friction"][-1]  # doctest: +SKIP
+    """
+
     scene: Scene
     numerics: Numerics
     status: RunStatus
@@ -60,6 +109,25 @@ class RunResult:
     @property
     def newton_iterations(self) -> int:
         return self.statistics.get("newton_iterations", 0)
+
+    @property
+    def x(self) -> np.ndarray:
+        """The grid's nodes (m)."""
+        return self.solution.x
+
+    @property
+    def fields(self) -> dict[str, np.ndarray]:
+        """The final state over :attr:`x`, as the analytic solution gives its own.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            ``x`` (m), ``u`` (m), ``theta`` (rad), ``strain``, ``tension`` (N),
+            ``moment`` (N m) and ``friction`` (N/m), one value per node: the columns of
+            ``fields.csv``. ``AnalyticSolution.fields(result.x)`` has the same keys but x.
+        """
+        fields = {"x": self.solution.x, **self.solution.fields()}
+        return {k: np.array(v) for k, v in fields.items()}  # copies: the state stays as it is
 
     def errors(self) -> dict | None:
         if self.reference is None:

@@ -22,29 +22,107 @@ GROWTH_LIMIT = 1e4  # |u| / (|e0| L) or |theta| / |e0| beyond this counts as div
 
 @dataclass(frozen=True)
 class Stop:
-    """A tracker's request to end the run."""
+    """A tracker's request to end the run, returned by :meth:`Tracker.handle`.
 
-    status: RunStatus
+    Parameters
+    ----------
+    status : RunStatus, optional
+        The status the run's result reports; INTERRUPTED (the default) for a run
+        stopped on the user's request.
+    reason : str, optional
+        Why, for ``RunResult.reason`` (default: which tracker stopped it, and when).
+
+    Examples
+    --------
+    >>> Stop(reason="friction above 2 kN")
+    Stop(status=<RunStatus.INTERRUPTED: 'interrupted'>, reason='friction above 2 kN')
+    """
+
+    status: RunStatus = RunStatus.INTERRUPTED
     reason: str | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.status, RunStatus):
+            raise TypeError(f"Stop: status must be a RunStatus, got {self.status!r} (give "
+                            f"a reason as Stop(reason=...))")
 
 
 class Tracker:
+    """Something done between two chunks of a run's simulated time; subclass it.
+
+    A run calls :meth:`initialize` once before the first chunk, :meth:`handle` after
+    every chunk (a check: every quarter of the transit time L / c, or more often) and
+    :meth:`finalize` once at the end, whatever the end. Pass instances to
+    :func:`beltsim.run` or :meth:`beltsim.Simulation.run` as ``trackers=[...]``; they
+    handle each check after the run's own records (history, snapshots) and before its
+    steady-state test, so they see every check, the last one too.
+
+    What ``sim`` (a :class:`beltsim.Simulation`) offers at a check: ``sim.t`` (s),
+    ``sim.total_friction()`` (N), ``sim.rate()``, ``sim.solution()`` (the state read as
+    a solution: ``.fields()``, ``.summary()``), ``sim.state`` (the raw arrays, not to be
+    changed), ``sim.scene``, ``sim.params``, ``sim.numerics`` and ``sim.grid``.
+
+    A user's tracker is not stored in a checkpoint: a resumed run starts it afresh.
+
+    Examples
+    --------
+    >>> class FrictionLog(beltsim.Tracker):
+    ...     def initialize(self, sim):
+    ...         self.t, self.friction = [], []
+    ...     def handle(self, sim):
+    ...         self.t.append(sim.t)
+    ...         self.friction.append(sim.total_friction())
+    ...         if sim.total_friction() > 2e3:
+    ...             return beltsim.Stop(reason="friction above 2 kN")
+    >>> log = FrictionLog()
+    >>> result = beltsim.run(scene, trackers=[log])               # doctest: +SKIP
+    """
+
+    #: the key of the tracker's state in a checkpoint (built-in trackers that have one)
     name = ""
 
     def initialize(self, sim) -> None:
-        pass
+        """Called once, before the first chunk (and on a resumed run, before its first).
+
+        Parameters
+        ----------
+        sim : beltsim.Simulation
+            The simulation, at its starting time.
+        """
 
     def handle(self, sim) -> Stop | None:
+        """Called after every chunk of simulated time.
+
+        Parameters
+        ----------
+        sim : beltsim.Simulation
+            The simulation at the check (``sim.t``).
+
+        Returns
+        -------
+        Stop or None
+            A :class:`Stop` ends the run here (the trackers after this one skip the
+            check); None lets it go on.
+        """
         return None
 
     def finalize(self, sim, status: RunStatus) -> None:
-        pass
+        """Called once at the end, also after a numerical failure or an interruption.
+
+        Parameters
+        ----------
+        sim : beltsim.Simulation
+            The simulation as it ends (after a failure: at its last good check).
+        status : RunStatus
+            How the run ends.
+        """
 
     def state(self) -> dict:
+        """Arrays a resumed run needs (built-in trackers with a :attr:`name`)."""
         return {}
 
     def restore(self, data: dict) -> None:
-        pass
+        """Take back what :meth:`state` returned, from a checkpoint."""
 
 
 class DivergenceGuard(Tracker):
@@ -304,17 +382,18 @@ class PowerBalanceTracker(Tracker):
 
 
 class ProgressTracker(Tracker):
-    """A tqdm bar on a terminal: simulated time, rate and total friction."""
+    """A progress bar of simulated time, with the rate and the total friction.
+
+    ``tqdm.auto`` draws it as a widget in Jupyter and as text on a terminal (or in
+    whatever takes stderr: the CLI asks for it only on a terminal).
+    """
 
     def __init__(self):
         self.bar = None
 
     def initialize(self, sim):
-        import sys
+        from tqdm.auto import tqdm
 
-        from tqdm import tqdm
-        if not sys.stderr.isatty():
-            return
         self.bar = tqdm(total=sim.numerics.t_end, initial=sim.t, unit="s", unit_scale=True,
                         desc="simulated", leave=False,
                         bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s "
