@@ -54,3 +54,24 @@ def test_every_frame_names_the_scheme_and_the_damping():
     assert default == "implicit (time-accurate), damping 39 1/s"
     pseudo = scheme_label(load_scene(scene_path("paper_slip"), ["numerics.integrator=pseudo"]))
     assert pseudo.startswith("pseudo (pseudo-transient path)") and "acceleration" in pseudo
+
+
+def test_animating_leaves_the_users_matplotlib_as_it_was(tmp_path):
+    """No backend switch, no pyplot figure left open, no rcParams changed (the ffmpeg path
+    is set for the save only)."""
+    import matplotlib
+    import matplotlib.pyplot as plt
+
+    import beltsim
+    from beltsim.io.results import save_run
+    from beltsim.plots.animate import animate
+
+    result = beltsim.run(beltsim.load_scene(scene_path("paper_slip"),
+                                            ["numerics.elements=60"]), snapshot_interval=0.02)
+    save_run(result, tmp_path)
+    before = (matplotlib.get_backend(), plt.get_fignums(),
+              matplotlib.rcParams["animation.ffmpeg_path"])
+    path = animate(tmp_path / "snapshots.npz", tmp_path / "transient.mp4", "mp4", fps=5)
+    assert path.read_bytes()[4:8] == b"ftyp"
+    assert (matplotlib.get_backend(), plt.get_fignums(),
+            matplotlib.rcParams["animation.ffmpeg_path"]) == before

@@ -8,7 +8,8 @@ from PIL import Image
 import beltsim
 from beltsim.cli import main
 from beltsim.io.results import save_run
-from beltsim.plots.run import RunDirectoryError, history_figure, plot_run, read_run
+from beltsim.plots.common import save_figure
+from beltsim.plots.run import RunDirectoryError, plot_history, plot_run, read_run
 from helpers import scene_path
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -78,12 +79,14 @@ def test_history_columns_are_read_not_assumed(run_copy, tmp_path):
     extra = [lines[0] + ",slip_power,new_column"] + [r + ",1.0,2.0" for r in lines[1:]]
     (run_copy / "history.csv").write_text("\n".join(extra) + "\n")
     run = read_run(run_copy)
-    assert {"slip_power", "new_column"} <= set(run["history"])
-    assert_png(history_figure(run, None, tmp_path / "extra.png"))
+    assert {"slip_power", "new_column"} <= set(run.history)
+    fig = plot_history(run, exact=False)
+    assert fig.axes[-1].get_ylabel() == "new column"
+    assert_png(save_figure(plot_history, tmp_path / "extra.png", run, exact=False))
     (run_copy / "history.csv").write_text(lines[0] + "\n")
     run = read_run(run_copy)
-    assert len(run["history"]["t"]) == 0
-    assert_png(history_figure(run, None, tmp_path / "empty.png"))
+    assert len(run.history["t"]) == 0
+    assert_png(save_figure(plot_history, tmp_path / "empty.png", run, exact=False))
 
 
 def test_an_interrupted_run_is_drawn_as_it_stopped(tmp_path):
@@ -98,7 +101,7 @@ def test_an_interrupted_run_is_drawn_as_it_stopped(tmp_path):
     save_run(result, tmp_path, complete=False)
     assert not (tmp_path / "summary.json").exists() and (tmp_path / CHECKPOINT).exists()
     run = read_run(tmp_path)
-    assert "interrupted at t = " in run["summary"]["reason"]
+    assert "interrupted at t = " in run.summary["reason"]
     for path in plot_run(tmp_path):
         assert_png(path)
     (tmp_path / CHECKPOINT).unlink()  # no checkpoint and no summary: not a run

@@ -31,6 +31,11 @@ def _scene(args):
     return load_scene(args.scene, args.overrides)
 
 
+def _progress(args) -> bool:
+    """A progress bar unless --quiet, and only on a terminal: not in a captured log."""
+    return not args.quiet and sys.stderr.isatty()
+
+
 # ---------------------------------------------------------------------------
 # commands
 
@@ -92,7 +97,7 @@ def cmd_run(args):
         title = scene.title or args.scene
     # a summary.json present means the latest run in this directory finished
     (out / "summary.json").unlink(missing_ok=True)
-    result = sim.run(progress=not args.quiet, raise_on_failure=False, handle_signals=True,
+    result = sim.run(progress=_progress(args), raise_on_failure=False, handle_signals=True,
                      checkpoint=out / CHECKPOINT)
     if result.interrupted:
         save_run(result, out, complete=False)
@@ -136,7 +141,8 @@ def cmd_convergence(args):
 
     from . import solvers
     from .io.files import prepare_outdir, write_csv
-    from .plots.studies import error_vs_runtime
+    from .plots.common import save_figure
+    from .plots.studies import ERROR_VS_RUNTIME_DPI, error_vs_runtime
     from .studies import convergence as studies
 
     scene = _scene(args)
@@ -158,7 +164,8 @@ def cmd_convergence(args):
     write_csv(out / "convergence.csv", (*cols, "reason"),
               [[r[c] for r in rows] for c in (*cols, "reason")],
               text_columns={"scheme", "reason"})
-    error_vs_runtime(rows, out / "error_vs_runtime.png", title=f"{scene.title or args.scene}")
+    save_figure(error_vs_runtime, out / "error_vs_runtime.png", rows,
+                title=f"{scene.title or args.scene}", dpi=ERROR_VS_RUNTIME_DPI)
     print("observed order in the grid size (successive grids; least-squares fit):")
     for key in studies.ERROR_KEYS:
         for scheme, o in studies.observed_orders(rows, key).items():
@@ -218,7 +225,8 @@ def cmd_sweep(args):
     import numpy as np
 
     from .io.files import prepare_outdir, write_csv
-    from .plots.studies import creep_collapse
+    from .plots.common import save_figure
+    from .plots.studies import CREEP_COLLAPSE_DPI, creep_collapse
     from .studies import sweep
 
     scene = _scene(args)
@@ -242,7 +250,8 @@ def cmd_sweep(args):
     write_csv(out / "sweep.csv", cols, data)
     print(f"wrote {out / 'sweep.csv'}")
     if collapse:
-        creep_collapse(rows, out / "creep_collapse.png", title=scene.title)
+        save_figure(creep_collapse, out / "creep_collapse.png", rows, title=scene.title,
+                    dpi=CREEP_COLLAPSE_DPI)
         print(f"wrote {out / 'creep_collapse.png'}")
     return 0 if all(r["converged"] for r in rows) else 1
 
@@ -292,7 +301,7 @@ def cmd_animate(args):
         if not interval > 0:
             raise UsageError(f"--interval: must be > 0 s, got {interval}")
         out = prepare_outdir(args.out or Path("runs/out") / f"animate_{Path(args.scene).stem}")
-        result = run(scene, progress=not args.quiet, raise_on_failure=False,
+        result = run(scene, progress=_progress(args), raise_on_failure=False,
                      snapshot_interval=interval)
         save_run(result, out)
         print(f"ran {args.scene}: {'steady' if result.converged else result.reason} at "

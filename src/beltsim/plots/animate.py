@@ -20,7 +20,7 @@ from ..problem import analytic
 from ..problem.drive import drive_of, friction_factor, has_profiles, mismatch
 from ..simulation.solution import stress_resultants
 from ..solvers.settings import resolve
-from .common import pyplot
+from .common import offscreen, panel_axes
 
 MAX_FRAMES = 150
 # (key, axis label) of the panels, top to bottom
@@ -30,7 +30,18 @@ PANELS = (("friction", "friction f [N/m]"), ("tension", "tension T [N]"),
 
 
 def frame_fields(snaps: dict) -> dict:
-    """The five panel fields for every snapshot, arrays (frames, nodes)."""
+    """The five panel fields for every snapshot.
+
+    Parameters
+    ----------
+    snaps : dict
+        :func:`beltsim.io.results.read_snapshots` of a run.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``friction``, ``tension``, ``moment``, ``theta``, ``u``, each (frames, nodes).
+    """
     P = snaps["scene"].params
     he = np.diff(snaps["x"])
     u = snaps["u"].astype(float)
@@ -40,7 +51,17 @@ def frame_fields(snaps: dict) -> dict:
 
 
 def scheme_label(scene) -> str:
-    """The scheme and the damping a transient was computed with, for every frame."""
+    """The scheme and the damping a transient was computed with, for every frame.
+
+    Parameters
+    ----------
+    scene : Scene
+
+    Returns
+    -------
+    str
+        E.g. ``"implicit (time-accurate), damping 39 1/s"``.
+    """
     from .. import solvers
     from ..solvers.settings import resolve
 
@@ -63,11 +84,29 @@ def _limits(values, exact):
 
 
 def animate(snapshots_path, out_path, fmt: str = "gif", fps: int = 15) -> Path:
-    """Render the transient stored in ``snapshots_path`` to ``out_path`` (GIF or MP4)."""
+    """Render the transient stored in ``snapshots_path`` to ``out_path`` (GIF or MP4).
+
+    Parameters
+    ----------
+    snapshots_path : str or Path
+        A run's ``snapshots.npz``.
+    out_path : str or Path
+        The file to write (atomically).
+    fmt : {"gif", "mp4"}, optional
+    fps : int, optional
+        Frames per second.
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    OutputError
+        An unknown format, or a file that is not a snapshots file.
+    """
     import matplotlib
     from matplotlib import animation
-
-    plt = pyplot()
 
     if fmt not in ("gif", "mp4"):
         raise OutputError(f"--format: must be gif or mp4, got {fmt!r}")
@@ -90,8 +129,8 @@ def animate(snapshots_path, out_path, fmt: str = "gif", fps: int = 15) -> Path:
     if P.fstar is not None:
         f_cap = max(f_cap, 1.2 * P.fstar)
 
-    fig, axes = plt.subplots(len(PANELS), 1, figsize=(8, 9.5), sharex=True,
-                             constrained_layout=True)
+    with offscreen():  # a figure for a file: no window, no backend
+        fig, axes, _ = panel_axes(None, len(PANELS), figsize=(8, 9.5), sharex=True)
     lines, marks = {}, None
     for ax, (key, label) in zip(axes, PANELS):
         ax.axvspan(P.x1, P.x2, color="0.92", zorder=0)
@@ -141,17 +180,17 @@ def animate(snapshots_path, out_path, fmt: str = "gif", fps: int = 15) -> Path:
         return [*lines.values(), marks, stamp]
 
     out_path = Path(out_path)
-    try:
-        with atomic_path(out_path, suffix=f".{fmt}") as tmp:
-            anim = animation.FuncAnimation(fig, draw, frames=frames, blit=False)
-            if fmt == "gif":
-                writer = animation.PillowWriter(fps=fps)
-            else:
-                import imageio_ffmpeg
-                matplotlib.rcParams["animation.ffmpeg_path"] = imageio_ffmpeg.get_ffmpeg_exe()
-                writer = animation.FFMpegWriter(fps=fps, codec="libx264",
-                                                extra_args=["-pix_fmt", "yuv420p"])
+    with atomic_path(out_path, suffix=f".{fmt}") as tmp:
+        anim = animation.FuncAnimation(fig, draw, frames=frames, blit=False)
+        settings = {}
+        if fmt == "gif":
+            writer = animation.PillowWriter(fps=fps)
+        else:
+            import imageio_ffmpeg
+            # for this save only: the user's rcParams stay as they are
+            settings["animation.ffmpeg_path"] = imageio_ffmpeg.get_ffmpeg_exe()
+            writer = animation.FFMpegWriter(fps=fps, codec="libx264",
+                                            extra_args=["-pix_fmt", "yuv420p"])
+        with matplotlib.rc_context(settings):
             anim.save(tmp, writer=writer, dpi=80)
-    finally:
-        plt.close(fig)
     return out_path

@@ -2,7 +2,8 @@
 
 Figures 2-6 have the paper's two panels: inertia against no inertia (both perfect
 adhesion), and slip against no slip (both with inertia); Figure 7 the rotation for
-three friction limits against perfect adhesion.
+three friction limits against perfect adhesion. :func:`two_panel` and :func:`fig7` draw
+one figure on the caller's axes or a new figure; :func:`figures` writes all six.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..studies.paper import FIG7_FSTAR
-from .common import pyplot, save
+from .common import panel_axes, save_figure
 
 STYLE = {"quasistatic": ("tab:gray", "no inertia, no slip"),
          "inertia": ("tab:blue", "inertia, no slip"),
@@ -25,6 +26,7 @@ FIGURES = (("friction", 2, "distributed friction f [N/m]", "Distributed friction
            ("u", 6, "displacement u [m]", "Displacement"))
 PANELS = (("quasistatic", "inertia"), ("inertia", "slip"))
 PANEL_TITLES = ("inertia versus no inertia", "slip versus no slip")
+DPI = 120
 
 
 def _markers(ax, sim, field, color):
@@ -39,9 +41,37 @@ def _shade_contact(ax, P):
     ax.axvspan(P.x1, P.x2, color="0.92", zorder=0)
 
 
-def two_panel(field, number, ylabel, title, sols, sims, path):
-    plt = pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.3), constrained_layout=True)
+def two_panel(field, sols, sims=None, axes=None):
+    """One of Figures 2-6: ``field`` over x, inertia against none, and slip against none.
+
+    Parameters
+    ----------
+    field : str
+        ``"friction"`` (Fig. 2), ``"tension"``, ``"moment"``, ``"theta"`` or ``"u"``
+        (Fig. 6).
+    sols : dict of str to AnalyticSolution
+        :func:`beltsim.studies.paper.solutions`.
+    sims : dict, optional
+        Simulated steady states as markers (:func:`beltsim.studies.paper.simulate`).
+    axes : sequence of two Axes, optional
+        Where to draw; default a new figure with the paper's caption.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Raises
+    ------
+    ValueError
+        An unknown field.
+    """
+    spec = {f[0]: f[1:] for f in FIGURES}
+    if field not in spec:
+        raise ValueError(f"field: not one of the paper's fields ({', '.join(spec)}), got "
+                         f"{field!r}")
+    number, ylabel, title = spec[field]
+    sims = sims or {}
+    fig, axes, own = panel_axes(axes, 1, 2, figsize=(12, 4.3))
     for ax, cases, sub in zip(axes, PANELS, PANEL_TITLES):
         _shade_contact(ax, sols["inertia"].params)
         for case in cases:
@@ -59,20 +89,36 @@ def two_panel(field, number, ylabel, title, sols, sims, path):
                             xytext=(s.params.x2 + 0.06, top * (0.8 if case == "inertia"
                                                                 else 0.5)),
                             color=color, fontsize=9,
-                            arrowprops=dict(arrowstyle="->", color=color))
+                            arrowprops={"arrowstyle": "->", "color": color})
         ax.set_xlabel("x [m]")
         ax.set_ylabel(ylabel)
         ax.set_title(sub)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8, loc="upper left")
-    note = " (lines: analytic; markers: simulated from rest)" if sims else ""
-    fig.suptitle(f"Fig. {number}. {title} over the spatial coordinate{note}", fontsize=11)
-    return save(fig, path, dpi=120)
+    if own:
+        note = " (lines: analytic; markers: simulated from rest)" if sims else ""
+        fig.suptitle(f"Fig. {number}. {title} over the spatial coordinate{note}", fontsize=11)
+    return fig
 
 
-def fig7(sols, sims, path):
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 4.6), constrained_layout=True)
+def fig7(sols, sims=None, ax=None):
+    """Figure 7: the rotation for three friction limits against perfect adhesion.
+
+    Parameters
+    ----------
+    sols : dict of str to AnalyticSolution
+        :func:`beltsim.studies.paper.solutions`.
+    sims : dict, optional
+        Simulated steady states as markers.
+    ax : Axes, optional
+        Where to draw; default a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    sims = sims or {}
+    fig, (ax,), _ = panel_axes(ax, 1, figsize=(7.5, 4.6))
     _shade_contact(ax, sols["inertia"].params)
     colors = ("tab:orange", "tab:red", "tab:purple")
     for fs, color in zip(FIG7_FSTAR, colors):
@@ -90,14 +136,27 @@ def fig7(sols, sims, path):
                  "grows", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=9)
-    return save(fig, path, dpi=120)
+    return fig
 
 
 def figures(out_dir, sols: dict, sims: dict | None = None) -> list[Path]:
-    """fig2.png ... fig7.png in ``out_dir`` (analytic solutions, optional simulated markers)."""
-    sims = sims or {}
-    paths = [two_panel(field, number, ylabel, title, sols, sims,
-                       Path(out_dir) / f"fig{number}.png")
-             for field, number, ylabel, title in FIGURES]
-    paths.append(fig7(sols, sims, Path(out_dir) / "fig7.png"))
+    """Write fig2.png ... fig7.png in ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        An existing directory.
+    sols : dict of str to AnalyticSolution
+        :func:`beltsim.studies.paper.solutions`.
+    sims : dict, optional
+        Simulated steady states as markers.
+
+    Returns
+    -------
+    list of Path
+    """
+    paths = [save_figure(two_panel, Path(out_dir) / f"fig{number}.png", field, sols, sims,
+                         dpi=DPI)
+             for field, number, *_ in FIGURES]
+    paths.append(save_figure(fig7, Path(out_dir) / "fig7.png", sols, sims, dpi=DPI))
     return paths

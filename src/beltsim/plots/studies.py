@@ -1,4 +1,8 @@
-"""Figures of studies: error against run time, creep-zone collapse."""
+"""Figures of studies: error against run time, creep-zone collapse.
+
+Each takes the rows its study returned, an optional ``ax`` (or ``axes``) to draw on, and
+returns the Figure; :func:`beltsim.plots.common.save_figure` writes one to a file.
+"""
 
 from __future__ import annotations
 
@@ -6,16 +10,33 @@ import textwrap
 
 import numpy as np
 
-from .common import pyplot, save
+from .common import panel_axes
 
+#: the resolutions the CLI saves the two figures at
+ERROR_VS_RUNTIME_DPI, CREEP_COLLAPSE_DPI = 130, 110
 SCHEME_STYLE = {"explicit": ("tab:red", "s"), "implicit": ("tab:blue", "o"),
                 "steady": ("tab:green", "^"), "richardson": ("tab:purple", "D")}
 
 
-def error_vs_runtime(rows, path, title=""):
-    """Log-log error of the total friction against wall time, one line per scheme."""
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6.4, 4.6), constrained_layout=True)
+def error_vs_runtime(rows, title="", ax=None):
+    """Log-log error of the total friction against wall time, one line per scheme.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The rows of :func:`beltsim.studies.convergence.convergence` (scheme, elements,
+        wall_time, converged, error_total_friction); rows that did not converge are
+        left out.
+    title : str, optional
+        The axes' title (the scene's, typically).
+    ax : Axes, optional
+        Where to draw; default a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, (ax,), _ = panel_axes(ax, 1, figsize=(6.4, 4.6))
     for scheme in dict.fromkeys(r["scheme"] for r in rows):
         rs = [r for r in rows if r["scheme"] == scheme and r["converged"]]
         t = np.array([r["wall_time"] for r in rs])
@@ -31,17 +52,31 @@ def error_vs_runtime(rows, path, title=""):
                                "Error against run time (labels: elements)", 70), fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return save(fig, path, dpi=130)
+    return fig
 
 
-def creep_collapse(rows, path, title=""):
-    """Three panels for a sweep over f*: slip-zone length, theta(x), total friction."""
-    plt = pyplot()
+def creep_collapse(rows, title="", axes=None):
+    """Three panels for a sweep over f*: slip-zone length, theta(x), total friction.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The rows of :func:`beltsim.studies.sweep.sweep` over ``contact.max_friction``
+        with ``keep_theta``.
+    title : str, optional
+        The figure's title (a new figure only).
+    axes : sequence of three Axes, optional
+        Where to draw; default a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fs = np.array([r["value"] for r in rows], dtype=float)
     x2 = rows[0]["x2"]
     sim_len = np.array([x2 - r["slip_start"] for r in rows])
     ex_len = np.array([x2 - r["slip_start_analytic"] for r in rows])
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), constrained_layout=True)
+    fig, axes, own = panel_axes(axes, 1, 3, figsize=(15, 4.4))
     ax = axes[0]
     ax.loglog(fs, ex_len, "-", color="k", label="analytic")
     pos = sim_len > 0
@@ -83,6 +118,6 @@ def creep_collapse(rows, path, title=""):
     ax.set_title("Total friction tends to the adhesion value")
     ax.legend()
     ax.grid(True, which="both", alpha=0.3)
-    if title:
+    if title and own:
         fig.suptitle(title)
-    return save(fig, path, dpi=110)
+    return fig
