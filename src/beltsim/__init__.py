@@ -18,15 +18,28 @@ from .errors import (
     SceneError,
 )
 from .io.results import save_run
+from .plots.run import plot_fields, plot_history
 from .problem.analytic import AnalyticSolution, solve
+from .problem.builder import (
+    Beam,
+    Contact,
+    Motion,
+    NumericsSection,
+    Physics,
+    Sine,
+    Stiffness,
+)
 from .problem.scene import Scene, load_scene, paper_scene, scene_names, shipped_scene
 from .simulation.controller import Simulation, run
 from .simulation.result import RunResult, RunStatus
+from .simulation.trackers import Stop, Tracker
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "AnalyticSolution", "BeltsimError", "MissingInputError", "NoSolutionError",
-    "NumericalError", "RunResult", "RunStatus", "Scene", "SceneError", "Simulation",
-    "load_scene", "paper_scene", "run", "save_run", "scene_names", "shipped_scene", "solve",
+    "AnalyticSolution", "Beam", "BeltsimError", "Contact", "MissingInputError", "Motion",
+    "NoSolutionError", "NumericalError", "NumericsSection", "Physics", "RunResult",
+    "RunStatus", "Scene", "SceneError", "Simulation", "Sine", "Stiffness", "Stop", "Tracker",
+    "load_scene", "paper_scene", "plot_fields", "plot_history", "run", "save_run",
+    "scene_names", "shipped_scene", "solve",
 ]
