@@ -100,6 +100,14 @@ class RunRecord:
 def as_record(run) -> RunRecord:
     """A :class:`RunRecord` of a RunResult (or the record itself).
 
+    Parameters
+    ----------
+    run : RunResult or RunRecord
+
+    Returns
+    -------
+    RunRecord
+
     Raises
     ------
     TypeError
