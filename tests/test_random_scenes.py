@@ -9,12 +9,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from beltsim import solvers
+from beltsim.errors import FailureKind
 from beltsim.problem import analytic
 from beltsim.problem.scene import Scene, shipped_scene
+from beltsim.simulation import trackers
 from beltsim.solvers.settings import resolve
-from validation import random_scenes as rs
-from beltsim.studies.stability import ACCEPTED, CellStatus
+from beltsim.studies import stability
+from beltsim.studies.stability import ACCEPTED, CellStatus, stability_cell
 from helpers import module
+from validation import random_scenes as rs
 
 
 @settings(max_examples=300, deadline=None)
@@ -25,10 +28,8 @@ def test_every_drawn_scene_is_valid_and_runs_as_drawn(seed, index):
     # the file written for a failure reads back as the same scene
     again = Scene.from_dict(tomllib.loads(scene.to_toml()))
     assert again.to_dict() == scene.to_dict()
-    # the stability case built from it (a shipped scene, every key overridden) is it
-    case = rs.scene_case(scene)
-    assert shipped_scene(case.base, case.overrides).to_dict() == \
-        scene.to_dict()
+    # the stability case built from it runs it as drawn
+    assert rs.scene_case(scene).scene().to_dict() == scene.to_dict()
     assert 0.0 < P.x1 < P.x2 < P.L and -1.0 < scene.to_dict()["beam"]["poisson_ratio"] < 0.5
     assert 1e-6 * (1 - 1e-6) <= abs(P.e0) <= 0.05 * (1 + 1e-6)
     if P.inertia:
@@ -36,7 +37,7 @@ def test_every_drawn_scene_is_valid_and_runs_as_drawn(seed, index):
     # the numerics resolve (mismatch, regularisation, memory) for every applicable scheme
     for scheme in solvers.names():
         if not solvers.applicable(scheme, P.inertia):
-            resolve(scene.with_overrides([f"numerics.integrator={scheme}"]))
+            resolve(scene.with_overrides([("numerics.integrator", scheme)]))
 
 
 def test_the_draw_covers_the_space():
@@ -70,15 +71,22 @@ def test_the_same_seed_draws_the_same_scenes():
     assert a != [s.to_toml() for s in rs.draw_scenes(6, seed=6)]
 
 
-def test_reasons_are_grouped_by_the_key_they_name():
-    assert rs.reason_key("refused", "numerics.max_work: this explicit run may need 4e10") == \
-        "numerics.max_work"
-    assert rs.reason_key(CellStatus.REFUSED, "contact.start/end: the contact must") == \
-        "contact.start/end"
-    assert rs.reason_key("out of bounds", "u 0.03 > 0.02; theta 0.5 > 0.02") == "u, theta"
-    assert rs.reason_key("diverged", "theta grew without bound at t = 50.2 s (1.03e+04 "
-                         "times its scale)") == rs.reason_key(
-        "diverged", "theta grew without bound at t = 4.1 s (1.1e+04 times its scale)")
+def test_reasons_are_grouped_by_what_they_are_about(monkeypatch):
+    """A refusal counts by the key its SceneError names, a cell out of bounds by the
+    errors beyond their bounds, a failed run by its FailureKind: read from the objects."""
+    scene = shipped_scene("paper_slip", [("numerics.elements", 60)])
+    work = rs.random_cell(scene, 0, "explicit", extra=[("numerics.max_work", 1e3)])
+    assert (work["status"], work["reason_key"]) == ("refused", "numerics.max_work")
+    outside = rs.random_cell(scene, 0, "steady", extra=[("contact.end", 2.0)])
+    assert (outside["status"], outside["reason_key"]) == ("refused", "contact.start/end")
+    tight = stability_cell(rs.scene_case(scene), "steady",
+                           bounds={"total_friction": 0.0, "u": 1.0, "theta": 0.0})
+    assert tight["status"] is CellStatus.OUT_OF_BOUNDS
+    assert tight["reason_key"] == "total_friction, theta"
+    monkeypatch.setattr(trackers, "GROWTH_LIMIT", 1e-12)  # any growth is divergence
+    monkeypatch.setattr(stability, "_VERDICTS", {})
+    grew = rs.random_cell(scene, 0, "implicit")
+    assert (grew["status"], grew["reason_key"]) == ("diverged", FailureKind.GREW.value)
 
 
 def test_a_few_random_scenes_through_the_cli(tmp_path):
@@ -175,10 +183,10 @@ def test_an_undamped_scene_still_ringing_at_t_end_counts_as_bounded():
     scene cut as short is judged by its slowest mode instead (decaying at ~10 1/s it needs
     ~1.3 s, not the 0.003 s left after the ramp): bounded, stable but slow; a damped cell
     that could have settled stays a failure (tests/test_modes.py)."""
-    scene = shipped_scene("paper_slip", ["numerics.elements=120"])
-    short = ("numerics.t_end=0.02",)
-    undamped = rs.random_cell(scene.with_overrides(["physics.damping=0"]), 0, "implicit",
-                              extra=short)
+    scene = shipped_scene("paper_slip", [("numerics.elements", 120)])
+    short = (("numerics.t_end", 0.02),)
+    undamped = rs.random_cell(scene.with_overrides([("physics.damping", 0.0)]), 0,
+                              "implicit", extra=short)
     assert undamped["status"] == CellStatus.BOUNDED.value, undamped
     assert undamped["reason"].startswith("undamped, still ringing: not steady by t_end")
     damped = rs.random_cell(scene, 1, "implicit", extra=short)

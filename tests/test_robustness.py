@@ -12,6 +12,7 @@ import pytest
 
 import beltsim
 from beltsim import solvers
+from beltsim.errors import FailureKind
 from beltsim.io.files import read_csv
 from beltsim.io.results import write_checkpoint
 from beltsim.simulation.controller import Simulation
@@ -82,23 +83,26 @@ def test_divergence_stops_with_reason_and_last_good_state(tmp_path):
     too_large = dataclasses.replace(sim.numerics, dt=3 * sim.numerics.dt)
     sim.scheme.numerics = too_large
     res = sim.run(raise_on_failure=False)
-    assert res.failed and not res.converged
-    assert "at t = " in res.reason and ("grew without bound" in res.reason
-                                        or "non-finite" in res.reason)
+    assert res.failed and not res.converged and res.failure.diverged
+    assert res.failure in (FailureKind.GREW, FailureKind.NON_FINITE)
+    assert "at t = " in res.reason
     assert np.all(np.isfinite(res.solution.u)) and np.all(np.isfinite(res.solution.theta))
     summary = res.summary()
     assert summary["converged"] is False and summary["reason"] == res.reason
-    with pytest.raises(beltsim.NumericalError):
+    assert summary["failure"] == res.failure.value
+    with pytest.raises(beltsim.NumericalError) as info:
         sim2 = Simulation(_scene("numerics.integrator=explicit"))
         sim2.scheme.numerics = too_large
         sim2.run()
+    assert info.value.kind is res.failure and info.value.t > 0
 
 
 def test_newton_failure_is_reported_with_time():
     """One Newton iteration cannot solve a step of the nonlinear problem: the step is
     cut back until it is too small, and the run stops naming the time."""
     res = Simulation(_scene("numerics.newton_max_iterations=1")).run(raise_on_failure=False)
-    assert res.failed and "Newton iteration failed at t = " in res.reason
+    assert res.failed and res.failure is FailureKind.NEWTON and not res.failure.diverged
+    assert "Newton iteration failed at t = " in res.reason
     assert np.all(np.isfinite(res.solution.u))
 
 
@@ -123,7 +127,7 @@ def test_cli_numerical_failure_exits_3_with_summary_and_last_good_state(tmp_path
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
     assert "numerical failure" in proc.stderr and "at t = " in proc.stderr
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert summary["converged"] is False and "Newton" in summary["reason"]
+    assert summary["converged"] is False and summary["failure"] == "newton"
     fields = read_csv(tmp_path / "fields.csv")
     assert all(np.all(np.isfinite(v)) for v in fields.values())
     assert (tmp_path / "checkpoint.npz").exists()  # the last good state
