@@ -173,8 +173,9 @@ def test_valid_scenes_converge_within_bounds_or_are_refused(L, x1f, x2f, cfrac, 
     result = beltsim.run(paper_scene("slip", over), raise_on_failure=False)
     assert result.converged, result.reason
     err = result.errors()
-    # 400 elements: first-order errors ~2.5x those of the default grid; the bounds are
-    # the simulator's (0.5% friction, 2% u) widened by that factor
+    # scenes drawn across the valid ranges, so no one measurement: the acceptance bounds
+    # of the simulator (0.5% friction, 2% u) widened 2.5x for 400 elements, about
+    # (600 / 400)^2 times the default grid's second-order error
     assert err["total_friction"] < 0.0125 and err["u"] < 0.05
     assert err["slip_start"] < 0.0125 * L
 

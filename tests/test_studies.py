@@ -10,7 +10,7 @@ from beltsim.problem.scene import load_scene
 from beltsim.simulation.controller import Simulation
 from beltsim.studies import convergence
 from benchmarks import bench, peers
-from helpers import cli, module, scene_path
+from helpers import ERROR_FACTOR, cli, module, scene_path
 
 
 def test_a_refused_rung_is_reported_and_the_ladder_goes_on(tmp_path):
@@ -93,8 +93,9 @@ def test_bench_command_prints_json_last():
     assert last["elements"] == 20 and last["ours_converged"] is True
     assert last["ours_wall_time"] > 0 and last["ours_steady_wall_time"] > 0
     assert last["explicit_node_steps_per_s"] > 0 and last["cold_start_time"] is None
-    # 20 elements: the grid's second-order error is about 1e-2 (60 elements: 1.3e-3)
-    assert last["ours_error"] < 3e-2 and last["ours_steady_error"] < 3e-2
+    # 20 elements, second order: total friction measured 7.8e-3 (both schemes)
+    assert last["ours_error"] < ERROR_FACTOR * 7.8e-3
+    assert last["ours_steady_error"] < ERROR_FACTOR * 7.8e-3
 
 
 def test_lab_bench_against_peers_and_port():
@@ -107,21 +108,27 @@ def test_lab_bench_against_peers_and_port():
         assert key in last
     assert last["ours_wall_time"] > 0 and last["peer_wall_time"] > 0
     assert last["peer_converged"] is True and last["peer"] in ("radau", "bdf")
-    # the speedup is the chosen peer's own wall time over ours, read from the peer table
+    # the peer compared with is the fastest transient peer that converged, as reported
+    # in its own row of the table
+    converged = [k for k in ("radau", "bdf") if last["peers"][k]["converged"]]
+    assert last["peer"] == min(converged, key=lambda k: last["peers"][k]["wall_time"])
     chosen = last["peers"][last["peer"]]
-    assert chosen["converged"] and chosen["wall_time"] == last["peer_wall_time"]
-    assert last["speedup"] * last["ours_wall_time"] == pytest.approx(chosen["wall_time"])
+    assert (chosen["wall_time"], chosen["error"]) == (last["peer_wall_time"],
+                                                      last["peer_error"])
     for name in ("radau", "bdf", "newton"):
         row = last["peers"][name]
         assert {"wall_time", "error", "converged", "tolerance"} <= row.keys()
     assert last["peers"]["newton"]["converged"] is True and last["steady_speedup"] > 0
     # same grid, same discretisation, same steady criterion: the same steady state
     assert abs(last["ours_error"] - last["peer_error"]) < 1e-4
-    # the port of the default scheme: same steps, same state
+    # the port of the default scheme: the same steps, Newton iterations and end time, and
+    # the same state (total friction: measured 9e-16 relative from ours; other
+    # arithmetic in the linear solves, so a bound well above round-off)
     row = last["port"]
     assert row["converged"] is True and row["steps"] == row["ours_steps"] == last["ours_steps"]
-    assert row["total_friction_vs_ours"] < 1e-8
-    assert last["kernel_speedup"] * last["ours_wall_time"] == pytest.approx(row["wall_time"])
+    assert row["newton_iterations"] == row["ours_newton_iterations"]
+    assert row["simulated_time"] == row["ours_simulated_time"]
+    assert row["total_friction"] == pytest.approx(last["ours_total_friction"], rel=1e-10)
 
 
 def test_bench_refuses_a_bad_repeat_count(capsys):

@@ -24,12 +24,14 @@ def collapse():
 
 
 def test_simulated_slip_zone_matches_the_analytic_one(collapse):
-    """Within 5% or two grid cells (whichever is larger) from f* = 5e4 to 1e6."""
+    """From f* = 5e4 to 1e6 on the default grid (600 elements, a node at the expected
+    slip start; second order): the zone's length is off by 1.3e-5 ... 7.7e-5 of itself
+    (measured; the largest at f* = 1e6); bound 3x the largest."""
     for r in collapse[:-1]:
         x2 = paper_scene("slip").params.x2
         sim, exact = x2 - r["slip_start"], x2 - r["slip_start_analytic"]
         assert r["converged"]
-        assert abs(sim - exact) <= max(0.05 * exact, 2 * r["h_min"]), r["value"]
+        assert abs(sim - exact) <= 3 * 7.7e-5 * exact, r["value"]
 
 
 def test_slip_zone_shrinks_monotonically(collapse):
