@@ -17,14 +17,17 @@ PAPER = open(scene_path("paper_slip")).read()
 
 CORPUS = {
     "malformed": ("[beam\nlength = 1", "malformed TOML"),
-    "wrong type": (PAPER.replace("length = 1.0", 'length = "one"'), "beam.length: must be a number"),
+    "wrong type": (PAPER.replace("length = 1.0", 'length = "one"'),
+                   "beam.length: must be a number"),
     "nan": (PAPER.replace("height = 0.1", "height = nan"), "beam.height: must be finite"),
     "inf": (PAPER.replace("width = 0.1", "width = inf"), "beam.width: must be finite"),
     "unknown section": (PAPER + "\n[extras]\na = 1\n", "extras: unknown section"),
     "unknown key": (PAPER.replace("[motion]", "[motion]\nspeed = 3"), "motion.speed: unknown key"),
-    "negative": (PAPER.replace("density = 1500.0", "density = -1500.0"), "beam.density: must be > 0"),
+    "negative": (PAPER.replace("density = 1500.0", "density = -1500.0"),
+                 "beam.density: must be > 0"),
     "poisson": (PAPER.replace("poisson_ratio = 0.45", "poisson_ratio = 0.5"), "beam.poisson_ratio"),
-    "order": (PAPER.replace("start = 0.3333333333333333", "start = 0.9"), "contact.start: must be <"),
+    "order": (PAPER.replace("start = 0.3333333333333333", "start = 0.9"),
+              "contact.start: must be <"),
     "critical": (PAPER.replace("belt_speed = 120.0", "belt_speed = 150.0"), "critical speeds"),
     "stick with limit": (PAPER.replace('"coulomb"', '"stick"'), "contact.max_friction: only"),
     "missing key": (PAPER.replace("max_friction = 1.0e5", ""), "contact.max_friction: missing"),
@@ -87,6 +90,7 @@ def _assert_clean_error(proc, fragment, out_dir=None):
         assert not out_dir.exists() or not any(out_dir.iterdir())
 
 
+@pytest.mark.cli
 @pytest.mark.parametrize("case", ["malformed", "critical"])
 def test_corpus_in_a_real_process(tmp_path, case):
     """Exit status and stderr as a shell sees them."""
@@ -97,6 +101,7 @@ def test_corpus_in_a_real_process(tmp_path, case):
     _assert_clean_error(_subprocess("run", str(scene), "--out", str(out)), fragment, out)
 
 
+@pytest.mark.unit
 @pytest.mark.parametrize("case", sorted(CORPUS))
 @pytest.mark.parametrize("command", ["run", "analytic"])
 def test_corpus(tmp_path, _cli, case, command):
@@ -107,6 +112,7 @@ def test_corpus(tmp_path, _cli, case, command):
     _assert_clean_error(_cli(command, str(scene), "--out", str(out)), fragment, out)
 
 
+@pytest.mark.unit
 def test_missing_and_unreadable_files(tmp_path, _cli):
     out = tmp_path / "out"
     _assert_clean_error(_cli("run", str(tmp_path / "nope.toml"), "--out", str(out)),
@@ -117,6 +123,7 @@ def test_missing_and_unreadable_files(tmp_path, _cli):
     _assert_clean_error(_cli("analytic", str(link), "--out", str(out)), "not found", out)
 
 
+@pytest.mark.unit
 @pytest.mark.parametrize("assignment, fragment", [
     ("contact.nope=1", "contact.nope: unknown key"),
     ("nope.x=1", "unknown section"),
@@ -134,6 +141,7 @@ def test_bad_set(tmp_path, _cli, assignment, fragment):
                              str(out)), fragment, out)
 
 
+@pytest.mark.unit
 def test_output_directory_that_cannot_be_written(tmp_path, _cli):
     blocker = tmp_path / "file"
     blocker.write_text("x")
@@ -143,6 +151,7 @@ def test_output_directory_that_cannot_be_written(tmp_path, _cli):
                         "exists and is not a directory")
 
 
+@pytest.mark.cli
 def test_bad_options(tmp_path, _cli):
     _assert_clean_error(_cli("convergence", scene_path("paper_slip"), "--ladder", "10,x"),
                         "--ladder")
@@ -154,6 +163,7 @@ def test_bad_options(tmp_path, _cli):
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
 
 
+@pytest.mark.verification
 @settings(max_examples=15, deadline=None)
 @given(L=st.floats(0.6, 2.0), x1f=st.floats(0.15, 0.4), x2f=st.floats(0.55, 0.85),
        cfrac=st.floats(0.1, 0.9), e0=st.floats(-0.02, 0.02), logf=st.floats(4.3, 6.5),
@@ -180,6 +190,7 @@ def test_valid_scenes_converge_within_bounds_or_are_refused(L, x1f, x2f, cfrac, 
     assert err["slip_start"] < 0.0125 * L
 
 
+@pytest.mark.cli
 def test_python_dash_m_beltsim_is_the_command():
     proc = subprocess.run([sys.executable, "-m", "beltsim", "run", "missing.toml"],
                           capture_output=True, text=True, timeout=120)

@@ -18,6 +18,7 @@ def _scene(*overrides):
     return beltsim.load_scene(scene_path("paper_slip"), list(overrides))
 
 
+@pytest.mark.unit
 def test_table_value_is_numpys_interpolation_held_at_both_ends():
     times, vals = np.array([0.01, 0.02, 0.05]), np.array([3.0, -1.0, 2.0])
     prof = Profile(times, vals, 0.0, 0.0, 0.0, 0.0)
@@ -25,6 +26,7 @@ def test_table_value_is_numpys_interpolation_held_at_both_ends():
         assert value(prof, t) == pytest.approx(np.interp(t, times, vals), abs=1e-15)
 
 
+@pytest.mark.unit
 def test_sine_and_number_values():
     sine = Profile(np.zeros(0), np.zeros(0), 1.5, 0.25, 0.04, 0.0)
     for t in (0.0, 0.013, 0.5):
@@ -34,6 +36,7 @@ def test_sine_and_number_values():
     assert value(ramped, 0.05) == pytest.approx(2.0 * 0.5)  # the smoothstep's midpoint
 
 
+@pytest.mark.unit
 def test_scene_tables_become_the_drive():
     scene = _scene("motion.surface_speed=[[0.0, 120.0], [0.01, 121.2]]",
                    "contact.max_friction=[[0.0, 1e6], [0.02, 1e5]]")
@@ -49,6 +52,7 @@ def test_scene_tables_become_the_drive():
     assert beltsim.Scene(tomllib.loads(scene.to_toml())).to_dict() == scene.to_dict()
 
 
+@pytest.mark.unit
 @pytest.mark.parametrize("override, message", [
     ("motion.surface_speed=[]", "motion.surface_speed: a table needs at least one"),
     ("motion.surface_speed=[[0, 120], [0, 121]]", "row 2: times must increase strictly"),
@@ -69,12 +73,14 @@ def test_profile_rules_name_key_row_and_rule(override, message):
     assert message in str(info.value) and "\n" not in str(info.value)
 
 
+@pytest.mark.unit
 def test_two_sines_must_share_their_period():
     with pytest.raises(SceneError, match="must equal motion.surface_speed.period"):
         _scene("motion.surface_speed={mean=121.2, amplitude=0.1, period=0.02}",
                "contact.max_friction={mean=1e5, amplitude=1e4, period=0.03}")
 
 
+@pytest.mark.verification
 def test_a_table_ending_at_the_constant_value_reaches_the_same_state():
     """A start-up written as a table (linear, 2 transit times) against the default
     smoothstep ramp: both end on the same steady state, to the steady tolerance."""
@@ -89,6 +95,7 @@ def test_a_table_ending_at_the_constant_value_reaches_the_same_state():
     assert table.simulated_time > 0.0167
 
 
+@pytest.mark.verification
 def test_a_drop_of_the_friction_limit_ends_on_the_analytic_state_of_the_final_limit():
     """f* from 1e6 to 1e5 N/m after the start-up: the creep zone grows to the f* = 1e5
     state, which the run meets to the discretisation error of its grid (300 elements,
@@ -102,6 +109,7 @@ def test_a_drop_of_the_friction_limit_ends_on_the_analytic_state_of_the_final_li
     assert before > res.reference.x_star + 0.02
 
 
+@pytest.mark.verification
 @pytest.mark.parametrize("speed, measured, law", [(121.2, 7.4e-6, 4.7e-4),
                                                   (119.9, 1.4e-5, 0.12)])
 def test_slip_power_matches_the_analytic_value(speed, measured, law):
@@ -116,6 +124,7 @@ def test_slip_power_matches_the_analytic_value(speed, measured, law):
     assert abs(sol.slip_power - res.reference.slip_power) < 2 * law * res.reference.slip_power
 
 
+@pytest.mark.unit
 def test_history_slip_power_is_the_kernels_slip_term():
     """The numpy reading of the history agrees with physics.model.power_terms."""
     from beltsim.physics.model import POWER_TERMS, power_terms
@@ -130,6 +139,7 @@ def test_history_slip_power_is_the_kernels_slip_term():
                                                       rel=1e-12)
 
 
+@pytest.mark.verification
 def test_periodic_drive_stops_at_its_periodic_state_and_reports_the_last_period():
     """A sine of the surface speed: the run ends when two periods agree within the
     steady tolerance, and the summary gives the last period's extremes and means."""

@@ -14,6 +14,8 @@ from validation import random_scenes as rs
 from beltsim.studies import stability
 from beltsim.studies.stability import ACCEPTED, Case, CellStatus, stability_cell
 
+pytestmark = pytest.mark.unit
+
 
 def _slip(n, *over):
     return shipped_scene("paper_slip", [f"numerics.elements={n}", *over])

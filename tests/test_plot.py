@@ -11,6 +11,8 @@ from beltsim.io.results import save_run
 from beltsim.plots.run import RunDirectoryError, history_figure, plot_run, read_run
 from helpers import scene_path
 
+pytestmark = pytest.mark.unit
+
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 

@@ -1,4 +1,5 @@
-"""`python -m validation.random_scenes`: the draw is valid and reproducible, the CLI counts add up."""
+"""`python -m validation.random_scenes`: the draw is valid and reproducible, the CLI
+counts add up."""
 
 import csv
 import math
@@ -19,6 +20,8 @@ from beltsim.studies import stability
 from beltsim.studies.stability import ACCEPTED, CellStatus, stability_cell
 from helpers import module
 from validation import random_scenes as rs
+
+pytestmark = pytest.mark.lab
 
 
 @settings(max_examples=300, deadline=None)
@@ -90,6 +93,7 @@ def test_reasons_are_grouped_by_what_they_are_about(monkeypatch):
     assert (grew["status"], grew["reason_key"]) == ("diverged", FailureKind.GREW.value)
 
 
+@pytest.mark.cli
 def test_a_few_random_scenes_through_the_cli(tmp_path):
     """A coarse grid (60 elements): out of bounds is expected there; the files and the
     counts must agree with each other and with the exit status."""
@@ -133,6 +137,7 @@ def test_a_few_random_scenes_through_the_cli(tmp_path):
     assert proc.returncode == (1 if failed else 0), proc.stderr
 
 
+@pytest.mark.cli
 def test_max_wall_skips_the_cells_not_started(tmp_path):
     proc = module("validation.random_scenes", 3, "--seed", 3, "--elements", 60, "--max-wall",
                1e-9, "--out", tmp_path)
@@ -142,6 +147,7 @@ def test_max_wall_skips_the_cells_not_started(tmp_path):
     assert len(rows) == 3 * len(solvers.names()) and f"skipped {len(rows)}" in proc.stdout
 
 
+@pytest.mark.cli
 def test_bad_random_options_are_one_line_errors(tmp_path):
     for args in ([0], ["--seed", 3], [2, "--max-wall", -1]):
         proc = module("validation.random_scenes", *args, "--out", tmp_path)
@@ -211,9 +217,10 @@ def test_jobs_give_the_same_rows_in_the_same_order(monkeypatch):
     runs = {}
     for jobs in (1, 3):
         shown, failures = [], []
-        rows = rs.random_study(12, 5, jobs=jobs, progress=shown.append,
-                               on_failure=lambda s, r: failures.append(
-                                   (s.title, [x["scheme"] for x in r])))
+
+        def failed(scene, rows, failures=failures):
+            failures.append((scene.title, [x["scheme"] for x in rows]))
+        rows = rs.random_study(12, 5, jobs=jobs, progress=shown.append, on_failure=failed)
         runs[jobs] = (rows, shown, failures)
     assert runs[1] == runs[3]
     assert [(r["index"], r["scheme"]) for r in runs[3][1]] == [

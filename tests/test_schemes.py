@@ -6,6 +6,8 @@ import pytest
 import beltsim
 from helpers import ERROR_FACTOR, PAPER_ERRORS_500, assert_errors_near, scene_path
 
+pytestmark = pytest.mark.verification
+
 
 def _scene(name, *overrides):
     return beltsim.load_scene(scene_path(name), ["numerics.elements=300", *overrides])

@@ -13,6 +13,8 @@ from beltsim.physics.friction import law_numpy
 from beltsim.physics.model import strain_numpy
 from helpers import PAPER_ERRORS_500, assert_errors_near, scene_path
 
+pytestmark = pytest.mark.verification
+
 # 500 elements keeps each run near 30 ms; its errors are measured in PAPER_ERRORS_500.
 COARSE = "numerics.elements=500"
 

@@ -436,7 +436,8 @@ def _params(d: dict) -> Params:
 
 
 class Scene:
-    """A validated scene. Build it with :meth:`load`, :meth:`from_dict` or :meth:`with_overrides`."""
+    """A validated scene. Build it with :meth:`load`, :meth:`from_dict` or
+    :meth:`with_overrides`."""
 
     def __init__(self, data: dict, source: str | None = None):
         self._data = validate(data)
@@ -444,7 +445,7 @@ class Scene:
 
     # construction -----------------------------------------------------
     @classmethod
-    def load(cls, path) -> "Scene":
+    def load(cls, path) -> Scene:
         """Read and validate a scene file (TOML)."""
         path = Path(path)
         try:
@@ -462,7 +463,7 @@ class Scene:
         return cls.loads(text, source=str(path))
 
     @classmethod
-    def loads(cls, text: str, source: str | None = None) -> "Scene":
+    def loads(cls, text: str, source: str | None = None) -> Scene:
         """Parse and validate a scene from TOML text."""
         try:
             data = tomllib.loads(text)
@@ -471,13 +472,13 @@ class Scene:
         return cls(data, source=source)
 
     @classmethod
-    def from_dict(cls, data: dict) -> "Scene":
+    def from_dict(cls, data: dict) -> Scene:
         return cls(copy.deepcopy(data))
 
     def to_dict(self) -> dict:
         return copy.deepcopy(self._data)
 
-    def with_overrides(self, assignments) -> "Scene":
+    def with_overrides(self, assignments) -> Scene:
         """Apply ``SECTION.KEY=VALUE`` strings (or (key, value) pairs) and revalidate."""
         data = self.to_dict()
         for item in assignments:

@@ -27,7 +27,7 @@ BOUNDS = {"total_friction": 5e-3, "u": 2e-2, "theta": 2e-2, "concentrated_force"
           "slip_start": 5e-3}
 
 
-class CellStatus(str, enum.Enum):
+class CellStatus(enum.StrEnum):
     CONVERGED = "converged"
     BOUNDED = "bounded"  # a fixed span of simulated time: finite and bounded throughout
     OUT_OF_BOUNDS = "out of bounds"
