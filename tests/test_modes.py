@@ -14,7 +14,7 @@ from validation import random_scenes as rs
 from beltsim.studies import stability
 from beltsim.studies.stability import ACCEPTED, Case, CellStatus, stability_cell
 
-pytestmark = pytest.mark.unit
+pytestmark = pytest.mark.verification
 
 
 def _slip(n, *over):
