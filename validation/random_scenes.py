@@ -49,7 +49,8 @@ from beltsim.studies.stability import ACCEPTED, BOUNDS, Case, CellStatus, stabil
 
 SKIPPED = "skipped"  # not started: the run's --max-wall was spent
 CRASHED = "crashed"  # an exception that is not one of beltsim's own errors (a bug)
-PAPER_ELEMENTS = 1000  # the grid of the paper scenes (L = 1 m) that BOUNDS were set on
+#: The slip start's bound in mean element lengths L / N (:func:`scene_bounds`)
+SLIP_START_ELEMENTS = 5.0
 #: Columns of random.csv.
 COLUMNS = ("index", "scheme", "status", "reason_key", "friction", "inertia", "damping",
            "mismatch", "speed_ratio", "elements", "dt", "steps", "wall_time",
@@ -186,15 +187,14 @@ def random_cell(scene: Scene, index: int, scheme: str, extra=()) -> dict:
 def scene_bounds(scene: Scene, elements: int) -> dict:
     """stability.BOUNDS with the slip start's (in metres) scaled to the grid.
 
-    The paper's 5 mm on 1000 elements over 1 m is five mean element lengths: the slip
-    start sits on element boundaries (its error jumps between 4e-6 and 1e-3 m there), so
-    its bound is 5 L / N. Measured on random scene 56 of seed 1 (L = 42.5 m, 1000
-    elements of 42 mm on average): 9.8 mm, 0.23 of a mean element, out of the paper's
-    bound. The relative bounds stay: they hold on the default grid, which resolves the
-    scene's shortest decay length as it does the paper's.
+    The paper's 5 mm on 1000 elements over 1 m are SLIP_START_ELEMENTS mean element
+    lengths: the slip start's error is a fraction of an element, so on a long belt a
+    bound in metres fails however well the grid resolves the scene. The relative bounds
+    stay: they hold on the default grid, which resolves each scene's shortest decay
+    length as it does the paper's.
     """
     out = dict(BOUNDS)
-    out["slip_start"] = BOUNDS["slip_start"] * scene.params.L * (PAPER_ELEMENTS / elements)
+    out["slip_start"] = SLIP_START_ELEMENTS * scene.params.L / elements
     return out
 
 
@@ -376,7 +376,7 @@ def random_markdown(rows, seed: int, n: int, wall: float, extra=()) -> str:
     lines = [f"# Random scenes: {n} drawn with seed {seed}, on {grid}", "",
              (f"{len(rows)} cells in {wall:.0f} s wall; {sum(failed(r) for r in rows)} "
               f"failed. Bounds: {relative} (relative), slip start "
-              f"{BOUNDS['slip_start'] * PAPER_ELEMENTS:g} L / N (N elements)."), "",
+              f"{SLIP_START_ELEMENTS:g} L / N (N elements)."), "",
              "| scheme | " + " | ".join(statuses) + " |", "|---|" + "---|" * len(statuses)]
     for scheme in schemes + ["all"]:
         mine = Counter(r["status"] for r in rows if scheme in ("all", r["scheme"]))
