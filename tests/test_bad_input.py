@@ -11,6 +11,8 @@ from hypothesis import strategies as st
 
 import beltsim
 from beltsim.problem.scene import paper_scene
+from beltsim.simulation.result import RunStatus
+from beltsim.studies.stability import steady_state_stability
 from helpers import scene_path
 
 PAPER = open(scene_path("paper_slip")).read()
@@ -168,20 +170,27 @@ def test_bad_options(tmp_path, _cli):
 @given(L=st.floats(0.6, 2.0), x1f=st.floats(0.15, 0.4), x2f=st.floats(0.55, 0.85),
        cfrac=st.floats(0.1, 0.9), e0=st.floats(-0.02, 0.02), logf=st.floats(4.3, 6.5),
        inertia=st.booleans())
-def test_valid_scenes_converge_within_bounds_or_are_refused(L, x1f, x2f, cfrac, e0, logf,
-                                                            inertia):
+def test_valid_scenes_converge_within_bounds_unless_they_flutter(L, x1f, x2f, cfrac, e0, logf,
+                                                                inertia):
     """Across the valid ranges every scene runs: converged within the bounds for a coarse
     grid, with an analytic state to compare with; never NaN, never a silent wrong number.
+    A valid scene may flutter (e.g. L = 0.625 m, contact over [0.25, 0.625] L, c at 0.75
+    of the critical speed, e0 = 1/64, f* = 1e6: a 206 Hz mode grows at 5.4 1/s): a run
+    that does not settle must reach t_end and have a linearly unstable steady state.
     A mismatch below 1e-8 is refused by rule (round-off of v - c), so it is not drawn."""
     assume(abs(e0) >= 1e-6)
     P0 = paper_scene("slip").params
     c = cfrac * min(math.sqrt(P0.b1 / P0.rho), math.sqrt(P0.a / P0.I))
-    over = [f"beam.length={L}", f"contact.start={x1f * L}", f"contact.end={x2f * L}",
-            f"motion.belt_speed={c}", f"motion.surface_speed={c * (1 + e0)}",
-            f"contact.max_friction={10 ** logf}", f"physics.inertia={str(inertia).lower()}",
-            "numerics.elements=400"]
-    result = beltsim.run(paper_scene("slip", over), raise_on_failure=False)
-    assert result.converged, result.reason
+    scene = paper_scene("slip", [
+        ("beam.length", L), ("contact.start", x1f * L), ("contact.end", x2f * L),
+        ("motion.belt_speed", c), ("motion.surface_speed", c * (1 + e0)),
+        ("contact.max_friction", 10 ** logf), ("physics.inertia", inertia),
+        ("numerics.elements", 400)])
+    result = beltsim.run(scene, raise_on_failure=False)
+    if not result.converged:
+        unstable, why, _ = steady_state_stability(scene)
+        assert result.status is RunStatus.REACHED_END and unstable, (result.reason, why)
+        return
     err = result.errors()
     # scenes drawn across the valid ranges, so no one measurement: the acceptance bounds
     # of the simulator (0.5% friction, 2% u) widened 2.5x for 400 elements, about
