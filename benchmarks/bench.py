@@ -21,7 +21,7 @@ from beltsim.problem.scene import Scene, load_scene
 from beltsim.simulation.controller import Simulation
 from beltsim.simulation.result import reference_of
 from beltsim.simulation.solution import relative_error
-from beltsim.studies.bench import best_of, bench_json, explicit_node_steps_per_s, run_ours
+from beltsim.studies.bench import bench_json, best_of, explicit_node_steps_per_s, run_ours
 
 from . import peers, port
 

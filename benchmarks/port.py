@@ -35,7 +35,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from beltsim.errors import NumericalError
+from beltsim.errors import FailureKind, NumericalError
 from beltsim.physics.friction import SQRT, TANH, law_inverse_numpy, law_numpy
 from beltsim.physics.model import LAM_MAX, POWER_TERMS, strain_numpy
 from beltsim.problem.drive import friction_factor, mismatch
@@ -434,7 +434,7 @@ class PortScheme(Scheme):
                 state_restore(state, u_n, th_n, ud_n, td_n, lam_n)
                 self._store(h_prev, h_next, steps)
                 raise NumericalError(f"non-finite displacement or rotation at t = {t:.6g} s",
-                                     t=t, quantity="u/theta")
+                                     kind=FailureKind.NON_FINITE, t=t, quantity="u/theta")
             if ok and err <= tol:
                 hist["u"][:], hist["theta"][:] = u_n, th_n
                 hist["ud"][:], hist["td"][:] = ud_n, td_n
@@ -459,7 +459,7 @@ class PortScheme(Scheme):
                 self._store(h_prev, h_next, steps)
                 raise NumericalError(
                     f"Newton iteration failed at t = {t:.6g} s even with the step cut to "
-                    f"dt = {h_next:.3g} s", t=t, quantity="newton")
+                    f"dt = {h_next:.3g} s", kind=FailureKind.NEWTON, t=t, quantity="newton")
         self._store(h_prev, h_next, steps)
         return t
 

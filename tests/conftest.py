@@ -13,9 +13,28 @@ import sys
 import tempfile
 from pathlib import Path
 
+import pytest
+
 # the lab beside the package (benchmarks/, validation/) is imported from the checkout
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 if os.environ.get("NUMBA_BOUNDSCHECK", "0") not in ("", "0"):
     os.environ.setdefault("NUMBA_CACHE_DIR",
                           os.path.join(tempfile.gettempdir(), "beltsim-numba-boundscheck"))
+
+
+#: The markers of pyproject.toml's [tool.pytest.ini_options]; a test carries one at least.
+KINDS = ("unit", "verification", "cli", "lab")
+
+
+@pytest.hookimpl(tryfirst=True)  # before -m deselects: every collected test is checked
+def pytest_collection_modifyitems(config, items):
+    """Refuse to run when a test carries none of KINDS: `pytest -m unit` would silently
+    leave it out of every selection."""
+    bare = [item.nodeid for item in items
+            if not any(item.get_closest_marker(kind) for kind in KINDS)]
+    if bare:
+        raise pytest.UsageError(
+            f"{len(bare)} test(s) carry none of the markers {', '.join(KINDS)} (add one, "
+            f"e.g. a module-level pytestmark): {', '.join(bare[:5])}"
+            + (" ..." if len(bare) > 5 else ""))

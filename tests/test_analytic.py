@@ -19,6 +19,8 @@ from beltsim.errors import NoSolutionError
 from beltsim.problem import analytic
 from beltsim.problem.scene import Scene, paper_scene
 
+pytestmark = pytest.mark.unit
+
 
 def _scene(L, x1f, x2f, h, w, E, nu, k, dens, cfrac, e0, fstar, inertia, friction):
     data = {

@@ -2,11 +2,14 @@
 
 
 import numpy as np
+import pytest
 from PIL import Image
 
 from beltsim.io.results import read_snapshots
 from beltsim.plots.animate import frame_fields
 from helpers import cli, scene_path
+
+pytestmark = pytest.mark.cli
 
 
 def test_animate_runs_and_stores_a_gif_then_mp4_from_the_stored_run(tmp_path):

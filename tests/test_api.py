@@ -37,6 +37,8 @@ PAPER_SLIP = {"beam": PAPER_BEAM, "motion": Motion(belt_speed=120.0, surface_spe
               "physics": Physics(inertia=True, damping=39.0)}
 COARSE = NumericsSection(elements=60)  # a run in well under a second
 
+pytestmark = pytest.mark.unit
+
 
 # ---------------------------------------------------------------------------
 # the builder

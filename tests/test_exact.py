@@ -18,6 +18,8 @@ from beltsim.solvers.explicit import _friction_scalar
 from beltsim.solvers.ssn import Saddle, saddle_factor, saddle_substitute
 from helpers import scene_path
 
+pytestmark = pytest.mark.verification
+
 EXACT_LAW = 'numerics.friction_law="exact"'
 
 

@@ -25,6 +25,8 @@ from beltsim.solvers.explicit import (
 )
 from helpers import scene_path
 
+pytestmark = pytest.mark.verification
+
 
 def _scene(name, *overrides):
     return beltsim.load_scene(scene_path(name), ["numerics.elements=300", *overrides])

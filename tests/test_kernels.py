@@ -36,6 +36,8 @@ from beltsim.solvers.newton import (
 )
 from helpers import scene_path
 
+pytestmark = pytest.mark.unit
+
 
 def _setup(overrides=(), N=40, dual=0):
     sc = Scene.load(scene_path("paper_slip")).with_overrides([f"numerics.elements={N}",

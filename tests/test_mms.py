@@ -20,6 +20,8 @@ from beltsim.physics.model import Loads, forces_numpy
 from beltsim.problem.drive import friction_factor, mismatch
 from helpers import scene_path
 
+pytestmark = pytest.mark.verification
+
 OMEGA = 400.0  # rad/s: a few periods over the span, resolved by the steps below
 SPAN = 0.02  # s
 TABLE = 4001  # table times over the span

@@ -13,6 +13,7 @@ PUBLISHED = {"No inertia, no slip": (6482, 6237, 12719),
              "With inertia, with slip": (3253, 3870, 7124)}
 
 
+@pytest.mark.unit
 def test_table1_reproduces_the_published_numbers():
     for row in paper.table1():
         got = (round(row["concentrated_or_slipping"]), round(row["distributed_or_sticking"]),
@@ -20,12 +21,14 @@ def test_table1_reproduces_the_published_numbers():
         assert got == PUBLISHED[row["case"]]
 
 
+@pytest.mark.unit
 def test_format_table1_prints_whole_newtons():
     text = paper.format_table1(paper.table1())
     for numbers in PUBLISHED.values():
         assert all(str(n) in text for n in numbers)
 
 
+@pytest.mark.cli
 @pytest.mark.parametrize("with_sim", [False, True])
 def test_paper_command_writes_table_and_figures(tmp_path, with_sim):
     args = [sys.executable, "-m", "beltsim.cli", "paper", "--out", str(tmp_path)]

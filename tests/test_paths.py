@@ -7,6 +7,8 @@ import pytest
 import beltsim
 from helpers import scene_path
 
+pytestmark = pytest.mark.verification
+
 # a coarse grid and the first 0.15 s (ramp, slip-zone growth, ringing of the free spans)
 PATH = ["numerics.elements=300", "numerics.grading=8", "numerics.t_end=0.15"]
 

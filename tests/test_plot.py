@@ -12,6 +12,8 @@ from beltsim.plots.common import save_figure
 from beltsim.plots.run import RunDirectoryError, plot_history, plot_run, read_run
 from helpers import scene_path
 
+pytestmark = pytest.mark.unit
+
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 

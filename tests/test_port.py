@@ -13,6 +13,8 @@ from beltsim.simulation.controller import Simulation
 from benchmarks import port
 from helpers import scene_path
 
+pytestmark = pytest.mark.lab
+
 
 def _runs(overrides, solver="splu"):
     scene = load_scene(scene_path("paper_slip"), overrides)

@@ -1,20 +1,27 @@
-"""`python -m validation.random_scenes`: the draw is valid and reproducible, the CLI counts add up."""
+"""`python -m validation.random_scenes`: the draw is valid and reproducible, the CLI
+counts add up."""
 
 import csv
 import math
 import tomllib
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from beltsim import solvers
+from beltsim.errors import FailureKind
 from beltsim.problem import analytic
 from beltsim.problem.scene import Scene, shipped_scene
+from beltsim.simulation import trackers
 from beltsim.solvers.settings import resolve
-from validation import random_scenes as rs
-from beltsim.studies.stability import ACCEPTED, CellStatus
+from beltsim.studies import stability
+from beltsim.studies.stability import ACCEPTED, CellStatus, stability_cell
 from helpers import module
+from validation import random_scenes as rs
+
+pytestmark = pytest.mark.lab
 
 
 @settings(max_examples=300, deadline=None)
@@ -25,10 +32,8 @@ def test_every_drawn_scene_is_valid_and_runs_as_drawn(seed, index):
     # the file written for a failure reads back as the same scene
     again = Scene.from_dict(tomllib.loads(scene.to_toml()))
     assert again.to_dict() == scene.to_dict()
-    # the stability case built from it (a shipped scene, every key overridden) is it
-    case = rs.scene_case(scene)
-    assert shipped_scene(case.base, case.overrides).to_dict() == \
-        scene.to_dict()
+    # the stability case built from it runs it as drawn
+    assert rs.scene_case(scene).scene().to_dict() == scene.to_dict()
     assert 0.0 < P.x1 < P.x2 < P.L and -1.0 < scene.to_dict()["beam"]["poisson_ratio"] < 0.5
     assert 1e-6 * (1 - 1e-6) <= abs(P.e0) <= 0.05 * (1 + 1e-6)
     if P.inertia:
@@ -36,7 +41,7 @@ def test_every_drawn_scene_is_valid_and_runs_as_drawn(seed, index):
     # the numerics resolve (mismatch, regularisation, memory) for every applicable scheme
     for scheme in solvers.names():
         if not solvers.applicable(scheme, P.inertia):
-            resolve(scene.with_overrides([f"numerics.integrator={scheme}"]))
+            resolve(scene.with_overrides([("numerics.integrator", scheme)]))
 
 
 def test_the_draw_covers_the_space():
@@ -70,17 +75,25 @@ def test_the_same_seed_draws_the_same_scenes():
     assert a != [s.to_toml() for s in rs.draw_scenes(6, seed=6)]
 
 
-def test_reasons_are_grouped_by_the_key_they_name():
-    assert rs.reason_key("refused", "numerics.max_work: this explicit run may need 4e10") == \
-        "numerics.max_work"
-    assert rs.reason_key(CellStatus.REFUSED, "contact.start/end: the contact must") == \
-        "contact.start/end"
-    assert rs.reason_key("out of bounds", "u 0.03 > 0.02; theta 0.5 > 0.02") == "u, theta"
-    assert rs.reason_key("diverged", "theta grew without bound at t = 50.2 s (1.03e+04 "
-                         "times its scale)") == rs.reason_key(
-        "diverged", "theta grew without bound at t = 4.1 s (1.1e+04 times its scale)")
+def test_reasons_are_grouped_by_what_they_are_about(monkeypatch):
+    """A refusal counts by the key its SceneError names, a cell out of bounds by the
+    errors beyond their bounds, a failed run by its FailureKind: read from the objects."""
+    scene = shipped_scene("paper_slip", [("numerics.elements", 60)])
+    work = rs.random_cell(scene, 0, "explicit", extra=[("numerics.max_work", 1e3)])
+    assert (work["status"], work["reason_key"]) == ("refused", "numerics.max_work")
+    outside = rs.random_cell(scene, 0, "steady", extra=[("contact.end", 2.0)])
+    assert (outside["status"], outside["reason_key"]) == ("refused", "contact.start/end")
+    tight = stability_cell(rs.scene_case(scene), "steady",
+                           bounds={"total_friction": 0.0, "u": 1.0, "theta": 0.0})
+    assert tight["status"] is CellStatus.OUT_OF_BOUNDS
+    assert tight["reason_key"] == "total_friction, theta"
+    monkeypatch.setattr(trackers, "GROWTH_LIMIT", 1e-12)  # any growth is divergence
+    monkeypatch.setattr(stability, "_VERDICTS", {})
+    grew = rs.random_cell(scene, 0, "implicit")
+    assert (grew["status"], grew["reason_key"]) == ("diverged", FailureKind.GREW.value)
 
 
+@pytest.mark.cli
 def test_a_few_random_scenes_through_the_cli(tmp_path):
     """A coarse grid (60 elements): out of bounds is expected there; the files and the
     counts must agree with each other and with the exit status."""
@@ -124,6 +137,7 @@ def test_a_few_random_scenes_through_the_cli(tmp_path):
     assert proc.returncode == (1 if failed else 0), proc.stderr
 
 
+@pytest.mark.cli
 def test_max_wall_skips_the_cells_not_started(tmp_path):
     proc = module("validation.random_scenes", 3, "--seed", 3, "--elements", 60, "--max-wall",
                1e-9, "--out", tmp_path)
@@ -133,6 +147,7 @@ def test_max_wall_skips_the_cells_not_started(tmp_path):
     assert len(rows) == 3 * len(solvers.names()) and f"skipped {len(rows)}" in proc.stdout
 
 
+@pytest.mark.cli
 def test_bad_random_options_are_one_line_errors(tmp_path):
     for args in ([0], ["--seed", 3], [2, "--max-wall", -1]):
         proc = module("validation.random_scenes", *args, "--out", tmp_path)
@@ -144,7 +159,8 @@ def test_the_slip_start_bound_scales_with_the_grid():
     from beltsim.studies.stability import BOUNDS
     assert rs.scene_bounds(paper_scene("slip"), 1000) == BOUNDS  # what BOUNDS were set on
     long = paper_scene("slip", ["beam.length=40", "contact.start=10", "contact.end=30"])
-    assert rs.scene_bounds(long, 2000)["slip_start"] == 40 * BOUNDS["slip_start"] / 2
+    # five mean element lengths: 40 m over 2000 elements
+    assert rs.scene_bounds(long, 2000)["slip_start"] == pytest.approx(5 * 40 / 2000)
     assert rs.scene_bounds(long, 2000)["theta"] == BOUNDS["theta"]
 
 
@@ -175,10 +191,10 @@ def test_an_undamped_scene_still_ringing_at_t_end_counts_as_bounded():
     scene cut as short is judged by its slowest mode instead (decaying at ~10 1/s it needs
     ~1.3 s, not the 0.003 s left after the ramp): bounded, stable but slow; a damped cell
     that could have settled stays a failure (tests/test_modes.py)."""
-    scene = shipped_scene("paper_slip", ["numerics.elements=120"])
-    short = ("numerics.t_end=0.02",)
-    undamped = rs.random_cell(scene.with_overrides(["physics.damping=0"]), 0, "implicit",
-                              extra=short)
+    scene = shipped_scene("paper_slip", [("numerics.elements", 120)])
+    short = (("numerics.t_end", 0.02),)
+    undamped = rs.random_cell(scene.with_overrides([("physics.damping", 0.0)]), 0,
+                              "implicit", extra=short)
     assert undamped["status"] == CellStatus.BOUNDED.value, undamped
     assert undamped["reason"].startswith("undamped, still ringing: not steady by t_end")
     damped = rs.random_cell(scene, 1, "implicit", extra=short)
@@ -201,9 +217,10 @@ def test_jobs_give_the_same_rows_in_the_same_order(monkeypatch):
     runs = {}
     for jobs in (1, 3):
         shown, failures = [], []
-        rows = rs.random_study(12, 5, jobs=jobs, progress=shown.append,
-                               on_failure=lambda s, r: failures.append(
-                                   (s.title, [x["scheme"] for x in r])))
+
+        def failed(scene, rows, failures=failures):
+            failures.append((scene.title, [x["scheme"] for x in rows]))
+        rows = rs.random_study(12, 5, jobs=jobs, progress=shown.append, on_failure=failed)
         runs[jobs] = (rows, shown, failures)
     assert runs[1] == runs[3]
     assert [(r["index"], r["scheme"]) for r in runs[3][1]] == [

@@ -12,6 +12,8 @@ from beltsim.problem.scene import SCHEMA, Scene, load_scene
 from beltsim.solvers.settings import resolve
 from helpers import scene_path
 
+pytestmark = pytest.mark.unit
+
 with open(scene_path("paper_slip"), "rb") as fh:
     BASE = tomllib.load(fh)  # coulomb, inertia
 
@@ -214,6 +216,7 @@ def test_a_study_whose_scenes_are_missing_fails(tmp_path, monkeypatch, capsys):
     assert not (tmp_path / "o" / "stability.csv").exists()
 
 
+@pytest.mark.cli  # and unit: a 60-element run
 def test_the_cli_runs_a_shipped_scene_by_name(tmp_path):
     from helpers import cli
     proc = cli("run", "paper_quasistatic", "--set", "numerics.elements=60", "--quiet",

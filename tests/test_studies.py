@@ -9,10 +9,11 @@ from beltsim.physics.friction import LINEAR
 from beltsim.problem.scene import load_scene
 from beltsim.simulation.controller import Simulation
 from beltsim.studies import convergence
-from benchmarks import bench, peers
-from helpers import cli, module, scene_path
+from benchmarks import peers
+from helpers import ERROR_FACTOR, cli, module, scene_path
 
 
+@pytest.mark.cli
 def test_a_refused_rung_is_reported_and_the_ladder_goes_on(tmp_path):
     # max_work 2e7 refuses the 240-element explicit run (~9e7 node-steps), admits 60 (~6e6)
     proc = cli("convergence", scene_path("paper_slip"), "--ladder", "240,60", "--schemes",
@@ -26,6 +27,8 @@ def test_a_refused_rung_is_reported_and_the_ladder_goes_on(tmp_path):
     assert "refused: numerics.max_work" in proc.stdout
 
 
+@pytest.mark.cli
+@pytest.mark.verification
 def test_convergence_command_small_ladder(tmp_path):
     proc = cli("convergence", scene_path("paper_slip"), "--ladder", "60,120,240", "--out",
                 str(tmp_path))
@@ -54,6 +57,7 @@ def read_csv_text(path):
         return list(csv.DictReader(fh))
 
 
+@pytest.mark.unit
 def test_observed_orders_recover_a_known_rate():
     rows = [{"scheme": "x", "converged": True, "h_min": h, "error_u": 3.0 * h**1.5}
             for h in (0.1, 0.05, 0.025)]
@@ -62,6 +66,7 @@ def test_observed_orders_recover_a_known_rate():
     assert abs(o["fit"] - 1.5) < 1e-12
 
 
+@pytest.mark.lab
 def test_peer_rhs_is_the_semi_discrete_model():
     """The peer's right-hand side and the implicit residual describe one model: a
     backward-Euler residual built from the peer's accelerations vanishes."""
@@ -86,6 +91,7 @@ def test_peer_rhs_is_the_semi_discrete_model():
     assert np.abs(R).max() < 1e-9 * scale
 
 
+@pytest.mark.cli
 def test_bench_command_prints_json_last():
     proc = cli("bench", "paper_slip", "--elements", "20", "--repeat", "1", "--no-cold")
     assert proc.returncode == 0, proc.stderr
@@ -93,10 +99,13 @@ def test_bench_command_prints_json_last():
     assert last["elements"] == 20 and last["ours_converged"] is True
     assert last["ours_wall_time"] > 0 and last["ours_steady_wall_time"] > 0
     assert last["explicit_node_steps_per_s"] > 0 and last["cold_start_time"] is None
-    # 20 elements: the grid's second-order error is about 1e-2 (60 elements: 1.3e-3)
-    assert last["ours_error"] < 3e-2 and last["ours_steady_error"] < 3e-2
+    # 20 elements, second order: total friction measured 7.8e-3 (both schemes)
+    assert last["ours_error"] < ERROR_FACTOR * 7.8e-3
+    assert last["ours_steady_error"] < ERROR_FACTOR * 7.8e-3
 
 
+@pytest.mark.lab
+@pytest.mark.cli
 def test_lab_bench_against_peers_and_port():
     proc = module("benchmarks.bench", "paper_slip", "--elements", "20", "--repeat", "1",
                   "--peer-cap", "60")
@@ -107,29 +116,37 @@ def test_lab_bench_against_peers_and_port():
         assert key in last
     assert last["ours_wall_time"] > 0 and last["peer_wall_time"] > 0
     assert last["peer_converged"] is True and last["peer"] in ("radau", "bdf")
-    # the speedup is the chosen peer's own wall time over ours, read from the peer table
+    # the peer compared with is the fastest transient peer that converged, as reported
+    # in its own row of the table
+    converged = [k for k in ("radau", "bdf") if last["peers"][k]["converged"]]
+    assert last["peer"] == min(converged, key=lambda k: last["peers"][k]["wall_time"])
     chosen = last["peers"][last["peer"]]
-    assert chosen["converged"] and chosen["wall_time"] == last["peer_wall_time"]
-    assert last["speedup"] * last["ours_wall_time"] == pytest.approx(chosen["wall_time"])
+    assert (chosen["wall_time"], chosen["error"]) == (last["peer_wall_time"],
+                                                      last["peer_error"])
     for name in ("radau", "bdf", "newton"):
         row = last["peers"][name]
         assert {"wall_time", "error", "converged", "tolerance"} <= row.keys()
     assert last["peers"]["newton"]["converged"] is True and last["steady_speedup"] > 0
     # same grid, same discretisation, same steady criterion: the same steady state
     assert abs(last["ours_error"] - last["peer_error"]) < 1e-4
-    # the port of the default scheme: same steps, same state
+    # the port of the default scheme: the same steps, Newton iterations and end time, and
+    # the same state (total friction: measured 9e-16 relative from ours; other
+    # arithmetic in the linear solves, so a bound well above round-off)
     row = last["port"]
     assert row["converged"] is True and row["steps"] == row["ours_steps"] == last["ours_steps"]
-    assert row["total_friction_vs_ours"] < 1e-8
-    assert last["kernel_speedup"] * last["ours_wall_time"] == pytest.approx(row["wall_time"])
+    assert row["newton_iterations"] == row["ours_newton_iterations"]
+    assert row["simulated_time"] == row["ours_simulated_time"]
+    assert row["total_friction"] == pytest.approx(last["ours_total_friction"], rel=1e-10)
 
 
+@pytest.mark.unit
 def test_bench_refuses_a_bad_repeat_count(capsys):
     from beltsim.cli import main
     assert main(["bench", "paper_slip", "--repeat", "0", "--no-cold"]) == 2
     assert "--repeat" in capsys.readouterr().err
 
 
+@pytest.mark.lab
 def test_peer_jacobian_is_the_derivative_of_its_rhs():
     """The analytic sparse Jacobian against 4th-order central differences of the rhs, at a
     random state whose contact nodes sit on the steep part of the friction law."""
@@ -155,6 +172,7 @@ def test_peer_jacobian_is_the_derivative_of_its_rhs():
     assert (slopes > 0.3).sum() >= 6 * 12  # at least 6 of the 12 contact nodes, 12 entries each
 
 
+@pytest.mark.lab
 def test_steady_peer_lands_on_the_steady_scheme_state():
     scene = load_scene(scene_path("paper_slip"), ["numerics.elements=100",
                                                   "numerics.integrator=steady"])
@@ -164,6 +182,7 @@ def test_steady_peer_lands_on_the_steady_scheme_state():
     assert abs(res.total_friction - ours) < 1e-8 * abs(ours)
 
 
+@pytest.mark.lab
 def test_radau_peer_reaches_the_steady_state_on_a_tiny_grid():
     scene = load_scene(scene_path("paper_slip"), ["numerics.elements=20"])
     res = peers.run_transient_peer(Simulation(scene), "Radau", max_wall=60.0)
@@ -173,6 +192,7 @@ def test_radau_peer_reaches_the_steady_state_on_a_tiny_grid():
     assert abs(res.total_friction - ref) < peers.SAME_STATE * abs(ref)
 
 
+@pytest.mark.unit
 def test_bisected_grid_is_nested():
     from beltsim.physics.grid import bisect, make_grid
     g = make_grid(1.0, 1 / 3, 2 / 3, 50, 8.0)
@@ -182,6 +202,7 @@ def test_bisected_grid_is_nested():
     np.testing.assert_allclose(f.he[0::2], g.he / 2)
 
 
+@pytest.mark.verification
 def test_richardson_extrapolation_beats_second_order_on_the_stick_scene():
     """The plain errors are second order, so (4 q(h/2) - q(h)) / 3 leaves a higher order.
     Below the default adhesion layer's own error (~2e-6) only with a thinner layer:

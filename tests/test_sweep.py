@@ -23,21 +23,26 @@ def collapse():
         return sweep.sweep(scene, "contact.max_friction", [*F_STARS, 1e7], ex)
 
 
+@pytest.mark.verification
 def test_simulated_slip_zone_matches_the_analytic_one(collapse):
-    """Within 5% or two grid cells (whichever is larger) from f* = 5e4 to 1e6."""
+    """From f* = 5e4 to 1e6 on the default grid (600 elements, a node at the expected
+    slip start; second order): the zone's length is off by 1.3e-5 ... 7.7e-5 of itself
+    (measured; the largest at f* = 1e6); bound 3x the largest."""
     for r in collapse[:-1]:
         x2 = paper_scene("slip").params.x2
         sim, exact = x2 - r["slip_start"], x2 - r["slip_start_analytic"]
         assert r["converged"]
-        assert abs(sim - exact) <= max(0.05 * exact, 2 * r["h_min"]), r["value"]
+        assert abs(sim - exact) <= 3 * 7.7e-5 * exact, r["value"]
 
 
+@pytest.mark.verification
 def test_slip_zone_shrinks_monotonically(collapse):
     lengths = [r["slip_start"] for r in collapse]
     assert all(b >= a for a, b in zip(lengths, lengths[1:]))  # x* moves towards x2
     assert lengths[-1] > lengths[0]
 
 
+@pytest.mark.verification
 def test_large_friction_limit_is_perfect_adhesion(collapse):
     """At f* = 1e7 the total friction is within 0.3% of the perfect-adhesion value."""
     last = collapse[-1]
@@ -46,6 +51,7 @@ def test_large_friction_limit_is_perfect_adhesion(collapse):
     assert rel / last["total_friction_adhesion"] < 3e-3
 
 
+@pytest.mark.unit
 def test_parse_vary_validates():
     assert sweep.parse_vary("contact.max_friction=1e5, 2e5") == (
         "contact.max_friction", [1e5, 2e5])
@@ -57,6 +63,7 @@ def test_parse_vary_validates():
         sweep.sweep(paper_scene("slip"), "contact.max_friction", [1e5, -1.0])
 
 
+@pytest.mark.cli
 def test_sweep_command_writes_csv_and_figure(tmp_path):
     proc = subprocess.run(
         [sys.executable, "-m", "beltsim.cli", "sweep", scene_path("paper_slip"), "--vary",
@@ -72,6 +79,7 @@ def test_sweep_command_writes_csv_and_figure(tmp_path):
     assert (tmp_path / "creep_collapse.png").stat().st_size > 20_000
 
 
+@pytest.mark.unit
 def test_scheduler_without_dask_is_a_clean_error(tmp_path, monkeypatch, capsys):
     """Dask missing (its import made to fail, whether or not it is installed): exit 2 with
     one line naming the extra to install."""

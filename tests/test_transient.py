@@ -65,6 +65,7 @@ def history_error(scene, result):
 # the exact solution, independently of its derivation
 
 
+@pytest.mark.unit
 @pytest.mark.parametrize("ramp_time", [None, 1e-3, 0.0])
 def test_inlet_strain_solves_its_ode(ramp_time):
     """x1 eps_in' = (v(t) - c) - c eps_in by DOP853 against the closed form (T = 2L/c,
@@ -90,6 +91,7 @@ def test_inlet_strain_solves_its_ode(ramp_time):
     assert np.max(np.abs(y - exact.inlet_strain(t))) <= 1e-12 * abs(P.e0)
 
 
+@pytest.mark.unit
 def test_drive_and_ramp_time_are_the_simulations():
     scene = thin_scene("coulomb")
     exact, sim = thin_belt(scene), beltsim.Simulation(scene)
@@ -105,6 +107,7 @@ CASES = [("coulomb", ()), ("coulomb", ("motion.surface_speed=118.8",)),
          ("stick", ("motion.surface_speed=118.8",))]
 
 
+@pytest.mark.unit
 @pytest.mark.parametrize("kind,extra", CASES)
 def test_fields_satisfy_the_bar_equations(kind, extra):
     """Finite differences of the exact u(x, t): b1 u_xx + f = 0, v_rel = 0 in stick,
@@ -166,6 +169,7 @@ def test_fields_satisfy_the_bar_equations(kind, extra):
         assert np.all(np.diff(x_stars) <= 0.0)  # the slip zone grows (monotone loading)
 
 
+@pytest.mark.unit
 @pytest.mark.parametrize("kind", ["coulomb", "stick"])
 def test_steady_limit_is_the_steady_solution(kind):
     """Late times tend to beltsim.solve of the same thin scene (derived independently);
@@ -182,6 +186,7 @@ def test_steady_limit_is_the_steady_solution(kind):
                                                               rel=1e-9)
 
 
+@pytest.mark.unit
 @pytest.mark.parametrize("overrides,key", [
     (("physics.inertia=true",), "physics.inertia"),
     (("beam.height=0.1",), "beam.height"),  # the paper's h with [stiffness]: eta = 3
@@ -197,6 +202,7 @@ def test_scenes_outside_the_limit_are_refused(overrides, key):
     assert str(info.value).startswith(key + ":") and "\n" not in str(info.value)
 
 
+@pytest.mark.unit
 def test_thin_needs_the_stiffness_held_fixed():
     """Without [stiffness], a, b1, b2 follow h and b1/a = 12/h^2: eta = 3 whatever h."""
     scene = beltsim.load_scene(scene_path("paper_slip"),
@@ -247,6 +253,7 @@ MEASURED_SECOND_ORDER = {"coulomb": [9.267e-5, 2.310e-5, 5.964e-6],
 MEASURED_PSEUDO_COARSEST = {"coulomb": 5.088e-3, "stick": 5.860e-3}
 
 
+@pytest.mark.verification
 @pytest.mark.parametrize("kind", ["coulomb", "stick"])
 def test_implicit_history_converges_at_second_order_in_grid_and_step(kind):
     errors = []
@@ -264,6 +271,7 @@ def test_implicit_history_converges_at_second_order_in_grid_and_step(kind):
     assert np.all(np.abs(orders - 2.0) <= 0.2), (errors, orders)
 
 
+@pytest.mark.verification
 @pytest.mark.parametrize("kind", ["coulomb", "stick"])
 def test_pseudo_history_converges_at_first_order(kind):
     errors = []
@@ -320,6 +328,7 @@ def _time_ladder(kind, scheme):
     return diffs, np.log2(diffs[:-1] / diffs[1:])
 
 
+@pytest.mark.verification
 @pytest.mark.parametrize("kind", ["coulomb", "stick"])
 def test_implicit_is_second_order_in_time(kind):
     diffs, orders = _time_ladder(kind, "implicit")
@@ -327,6 +336,7 @@ def test_implicit_is_second_order_in_time(kind):
     assert diffs[-1] <= 2.3e-4  # measured 1.64e-4 and 1.81e-4; 25% above the larger
 
 
+@pytest.mark.verification
 @pytest.mark.parametrize("kind", ["coulomb", "stick"])
 def test_pseudo_is_first_order_in_time(kind):
     diffs, orders = _time_ladder(kind, "pseudo")

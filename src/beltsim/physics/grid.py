@@ -66,9 +66,9 @@ def make_grid(L: float, x1: float, x2: float, elements: int, grading: float = 1.
     0.05 to 3.7 (theta) as x* crossed control-volume edges.
     """
     if elements < MIN_ELEMENTS:
-        raise SceneError(f"numerics.elements: must be >= {MIN_ELEMENTS}, got {elements}")
+        raise SceneError("numerics.elements", f"must be >= {MIN_ELEMENTS}, got {elements}")
     if grading < 1.0:
-        raise SceneError(f"numerics.grading: must be >= 1, got {grading}")
+        raise SceneError("numerics.grading", f"must be >= 1, got {grading}")
     centres = [x2, *refine_at]
     span = max(x2, L - x2)
 
@@ -103,7 +103,7 @@ def make_grid(L: float, x1: float, x2: float, elements: int, grading: float = 1.
     j1 = int(counts[0])
     j2 = int(counts[:-1].sum())
     if np.any(np.diff(x) <= 0.0):
-        raise SceneError("numerics.elements: too few elements for this grading and geometry")
+        raise SceneError("numerics.elements", "too few elements for this grading and geometry")
     return Grid(x=x, j1=j1, j2=j2)
 
 

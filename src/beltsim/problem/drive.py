@@ -39,7 +39,7 @@ class Profile(NamedTuple):
     ramp_time: float  # s; the value grows from 0 with the smoothstep over it; 0: none
 
     @classmethod
-    def constant(cls, value: float, ramp_time: float = 0.0) -> "Profile":
+    def constant(cls, value: float, ramp_time: float = 0.0) -> Profile:
         return cls(np.zeros(0), np.zeros(0), float(value), 0.0, 0.0, float(ramp_time))
 
 
@@ -48,7 +48,7 @@ class Drive(NamedTuple):
     friction: Profile  # f*(t) / f* (1 for perfect adhesion)
 
     @classmethod
-    def constant(cls, mismatch: float) -> "Drive":
+    def constant(cls, mismatch: float) -> Drive:
         """The full mismatch at once and a constant friction limit (the steady solver)."""
         return cls(Profile.constant(mismatch), Profile.constant(1.0))
 

@@ -49,33 +49,33 @@ class _Rule:
                 value = _number(key, value)
             else:
                 if isinstance(value, bool) or not isinstance(value, (int, float)):
-                    raise SceneError(f"{key}: must be a number, got {_show(value)}")
+                    raise SceneError(key, f"must be a number, got {_show(value)}")
                 if isinstance(value, float):
                     if not (math.isfinite(value) and value == int(value)):
-                        raise SceneError(f"{key}: must be a whole number, got {_show(value)}")
+                        raise SceneError(key, f"must be a whole number, got {_show(value)}")
                     value = int(value)
             if self.positive and not value > 0:
-                raise SceneError(f"{key}: must be > 0, got {_show(value)}")
+                raise SceneError(key, f"must be > 0, got {_show(value)}")
             if self.nonneg and not value >= 0:
-                raise SceneError(f"{key}: must be >= 0, got {_show(value)}")
+                raise SceneError(key, f"must be >= 0, got {_show(value)}")
             if self.minimum is not None and value < self.minimum:
-                raise SceneError(f"{key}: must be >= {self.minimum}, got {_show(value)}")
+                raise SceneError(key, f"must be >= {self.minimum}, got {_show(value)}")
             if self.interval is not None:
                 lo, hi = self.interval
                 if not lo < value < hi:
-                    raise SceneError(f"{key}: must lie in the open interval ({lo}, {hi}), "
+                    raise SceneError(key, f"must lie in the open interval ({lo}, {hi}), "
                                      f"got {_show(value)}")
             return value
         if self.kind == "bool":
             if not isinstance(value, bool):
-                raise SceneError(f"{key}: must be true or false, got {_show(value)}")
+                raise SceneError(key, f"must be true or false, got {_show(value)}")
             return value
         if self.kind == "str":
             if not isinstance(value, str):
-                raise SceneError(f"{key}: must be a string, got {_show(value)}")
+                raise SceneError(key, f"must be a string, got {_show(value)}")
             if self.choices is not None and value not in self.choices:
                 opts = " | ".join(f'"{c}"' for c in self.choices)
-                raise SceneError(f"{key}: must be one of {opts}, got {_show(value)}")
+                raise SceneError(key, f"must be one of {opts}, got {_show(value)}")
             return value
         if self.kind == "profile":
             return _check_profile(key, value)
@@ -88,9 +88,9 @@ SINE_KEYS = ("mean", "amplitude", "period")
 def _number(key, value):
     """A finite number as a float, or the one-line error of a float key."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise SceneError(f"{key}: must be a number, got {_show(value)}")
+        raise SceneError(key, f"must be a number, got {_show(value)}")
     if not math.isfinite(value):
-        raise SceneError(f"{key}: must be finite, got {_show(value)}")
+        raise SceneError(key, f"must be finite, got {_show(value)}")
     return float(value)
 
 
@@ -103,38 +103,38 @@ def _check_profile(key, value):
     if isinstance(value, dict):
         for k in value:
             if k not in SINE_KEYS:
-                raise SceneError(f"{key}.{k}: unknown key of a sine (known: "
+                raise SceneError(f"{key}.{k}", "unknown key of a sine (known: "
                                  f"{', '.join(SINE_KEYS)})")
         for k in SINE_KEYS:
             if k not in value:
-                raise SceneError(f"{key}.{k}: missing key of a sine (a sine is "
-                                 f"{{ mean = ..., amplitude = ..., period = ... }})")
+                raise SceneError(f"{key}.{k}", "missing key of a sine (a sine is "
+                                 "{ mean = ..., amplitude = ..., period = ... })")
         out = {k: _number(f"{key}.{k}", value[k]) for k in SINE_KEYS}
         if not out["period"] > 0:
-            raise SceneError(f"{key}.period: must be > 0, got {out['period']!r}")
+            raise SceneError(f"{key}.period", f"must be > 0, got {out['period']!r}")
         if not out["mean"] - abs(out["amplitude"]) > 0:
-            raise SceneError(f"{key}: must stay > 0, got mean - |amplitude| = "
+            raise SceneError(key, f"must stay > 0, got mean - |amplitude| = "
                              f"{out['mean'] - abs(out['amplitude'])!r}")
         return out
     if isinstance(value, list):
         if not value:
-            raise SceneError(f"{key}: a table needs at least one [time, value] row")
+            raise SceneError(key, "a table needs at least one [time, value] row")
         rows = []
         for i, row in enumerate(value, 1):
             name = f"{key} row {i}"
             if not isinstance(row, list) or len(row) != 2:
-                raise SceneError(f"{name}: must be a [time, value] pair, got {_show(row)}")
+                raise SceneError(name, f"must be a [time, value] pair, got {_show(row)}")
             t, v = _number(f"{name} time", row[0]), _number(f"{name} value", row[1])
             if rows and not t > rows[-1][0]:
-                raise SceneError(f"{name}: times must increase strictly, got {t!r} after "
+                raise SceneError(name, f"times must increase strictly, got {t!r} after "
                                  f"{rows[-1][0]!r}")
             if not v > 0:
-                raise SceneError(f"{name} value: must be > 0, got {v!r}")
+                raise SceneError(f"{name} value", f"must be > 0, got {v!r}")
             rows.append([t, v])
         return rows
     value = _number(key, value)
     if not value > 0:
-        raise SceneError(f"{key}: must be > 0, got {value!r}")
+        raise SceneError(key, f"must be > 0, got {value!r}")
     return value
 
 
@@ -235,7 +235,7 @@ _OPTIONAL_KEYS = {("physics", "damping")}
 # Keys that were, and what replaces them.
 _RETIRED = {
     ("numerics", "damping"): (
-        "numerics.damping: removed, damping is physics now: set physics.damping (1/s, the "
+        "removed, damping is physics now: set physics.damping (1/s, the "
         "rate d of d rho u_t and d I theta_t), or, for a fast path to the steady state "
         'whose transient does not matter, numerics.integrator = "pseudo" with '
         "numerics.acceleration (1/s)"),
@@ -253,18 +253,18 @@ def validate(data: dict) -> dict:
     for key, value in data.items():
         if key in SCHEMA:
             if not isinstance(value, dict):
-                raise SceneError(f"[{key}]: must be a table (section), got {_show(value)}")
+                raise SceneError(f"[{key}]", f"must be a table (section), got {_show(value)}")
             continue
         if key == "title":
             if not isinstance(value, str):
-                raise SceneError(f"title: must be a string, got {_show(value)}")
+                raise SceneError("title", f"must be a string, got {_show(value)}")
             out["title"] = value
             continue
         known = ", ".join([f"[{s}]" for s in SCHEMA] + list(TOP_LEVEL_KEYS))
-        raise SceneError(f"{key}: unknown section or key (known: {known})")
+        raise SceneError(key, f"unknown section or key (known: {known})")
     for section in REQUIRED_SECTIONS:
         if section not in data:
-            raise SceneError(f"[{section}]: missing section")
+            raise SceneError(f"[{section}]", "missing section")
     for section, rules in SCHEMA.items():
         if section not in data:
             continue
@@ -273,9 +273,9 @@ def validate(data: dict) -> dict:
         for key, value in table.items():
             name = f"{section}.{key}"
             if (section, key) in _RETIRED:
-                raise SceneError(_RETIRED[section, key])
+                raise SceneError(f"{section}.{key}", _RETIRED[section, key])
             if key not in rules:
-                raise SceneError(f"{name}: unknown key (known in [{section}]: "
+                raise SceneError(name, f"unknown key (known in [{section}]: "
                                  f"{', '.join(rules)})")
             clean[key] = rules[key].check(name, value)
         out[section] = clean
@@ -291,64 +291,64 @@ def validate(data: dict) -> dict:
             name = f"{section}.{key}"
             if (section, key) == ("contact", "max_friction"):
                 if friction == "coulomb":
-                    raise SceneError(f"{name}: missing key (required when contact.friction = "
-                                     f'"coulomb")')
+                    raise SceneError(name, "missing key (required when contact.friction = "
+                                     '"coulomb")')
                 continue
             if (section, key) == ("beam", "density") and inertia is False:
                 continue  # a quasistatic scene needs no density
             if (section, key) in _OPTIONAL_KEYS:
                 continue
-            raise SceneError(f"{name}: missing key")
+            raise SceneError(name, "missing key")
 
     for section, key in _ONLY_COULOMB:
         if key in out.get(section, {}) and friction != "coulomb":
-            raise SceneError(f'{section}.{key}: only for contact.friction = "coulomb" '
+            raise SceneError(f"{section}.{key}", f'only for contact.friction = "coulomb" '
                              f'(this scene is "{friction}")')
     for section, key in _ONLY_STICK:
         if key in out.get(section, {}) and friction != "stick":
-            raise SceneError(f'{section}.{key}: only for contact.friction = "stick" '
+            raise SceneError(f"{section}.{key}", f'only for contact.friction = "stick" '
                              f'(this scene is "{friction}")')
     law = out.get("numerics", {}).get("friction_law")
     if friction == "stick" and law not in (None, "exact"):
-        raise SceneError(f'numerics.friction_law: a "stick" scene takes only "exact" (exact '
+        raise SceneError("numerics.friction_law", f'a "stick" scene takes only "exact" (exact '
                          f'adhesion) or none (the adhesion layer), got "{law}"')
     if law == "exact":
         for key in ("regularisation", "adhesion_layer"):
             if key in out["numerics"]:
-                raise SceneError(f'numerics.{key}: not with numerics.friction_law = "exact" '
-                                 f"(exact friction has no regularisation)")
+                raise SceneError(f"numerics.{key}", 'not with numerics.friction_law = "exact" '
+                                 "(exact friction has no regularisation)")
     for section, key in _ONLY_INERTIA:
         if key in out.get(section, {}) and not inertia:
-            raise SceneError(f"{section}.{key}: only for physics.inertia = true "
-                             f"(a quasistatic scene has no inertia terms)")
+            raise SceneError(f"{section}.{key}", "only for physics.inertia = true "
+                             "(a quasistatic scene has no inertia terms)")
 
     beam, contact = out["beam"], out["contact"]
     L, x1, x2 = beam["length"], contact["start"], contact["end"]
     if not x1 < x2:
-        raise SceneError(f"contact.start: must be < contact.end, got start = {x1!r}, "
+        raise SceneError("contact.start", f"must be < contact.end, got start = {x1!r}, "
                          f"end = {x2!r}")
     if not (0.0 < x1 and x2 < L):
-        raise SceneError(f"contact.start/end: the contact must lie inside the beam, "
+        raise SceneError("contact.start/end", f"the contact must lie inside the beam, "
                          f"0 < start < end < beam.length = {L!r}, got [{x1!r}, {x2!r}]")
 
     P = _params(out)
     if P.inertia and (P.rho * P.c**2 >= P.b1 or P.I * P.c**2 >= P.a):
         c_t, c_b = P.critical_speeds
         raise SceneError(
-            f"motion.belt_speed: must stay below both critical speeds, "
+            "motion.belt_speed", f"must stay below both critical speeds, "
             f"sqrt(b1/rho) = {c_t:.6g} m/s and sqrt(a/I) = {c_b:.6g} m/s, got {P.c!r} m/s")
     speed = out["motion"]["surface_speed"]
     if P.inertia and not isinstance(speed, float):
         top, crit = profile_extremes(speed)[1], min(P.critical_speeds)
         if top >= crit:
-            raise SceneError(f"motion.surface_speed: every speed of the profile must stay "
+            raise SceneError("motion.surface_speed", f"every speed of the profile must stay "
                              f"below both critical speeds (the lower is {crit:.6g} m/s), "
                              f"got {top!r} m/s")
     periods = {k: v["period"] for k, v in (("motion.surface_speed", speed),
                ("contact.max_friction", out["contact"].get("max_friction")))
                if isinstance(v, dict)}
     if len(set(periods.values())) > 1:
-        raise SceneError("contact.max_friction.period: must equal motion.surface_speed.period "
+        raise SceneError("contact.max_friction.period", "must equal motion.surface_speed.period "
                          "(a run has one periodic steady state), got "
                          f"{periods['contact.max_friction']!r} and "
                          f"{periods['motion.surface_speed']!r}")
@@ -371,7 +371,7 @@ def _stiffness(d: dict) -> dict:
     if d["physics"]["inertia"]:
         rho3 = beam.get("density")
         if rho3 is None and ("mass" not in over or "rotary_inertia" not in over):
-            raise SceneError("beam.density: missing key")
+            raise SceneError("beam.density", "missing key")
         p["rho"] = over.get("mass", (rho3 or 0.0) * h * w)
         p["I"] = over.get("rotary_inertia", (rho3 or 0.0) * h * w * (h * h + w * w) / 12.0)
     return p
@@ -822,14 +822,14 @@ def parse_assignment(text: str):
     key, raw = text.split("=", 1)
     key, raw = key.strip(), raw.strip()
     if raw == "":
-        raise SceneError(f"{key}: empty value in --set")
+        raise SceneError(key, "empty value in --set")
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         if raw.replace("_", "").isalnum() and not raw[0].isdigit():
             value = raw  # bare word, e.g. friction=coulomb
         else:
-            raise SceneError(f"{key}: cannot parse value {raw!r} in --set") from None
+            raise SceneError(key, f"cannot parse value {raw!r} in --set") from None
     if isinstance(value, str) and raw.lower() in ("nan", "inf", "+inf", "-inf"):
         value = float(raw)
     return key, value
@@ -841,14 +841,14 @@ def set_key(data: dict, key: str, value) -> None:
         data["title"] = value
         return
     if "." not in key:
-        raise SceneError(f"{key}: expected SECTION.KEY (sections: {', '.join(SCHEMA)})")
+        raise SceneError(key, f"expected SECTION.KEY (sections: {', '.join(SCHEMA)})")
     section, name = key.split(".", 1)
     if section not in SCHEMA:
-        raise SceneError(f"{key}: unknown section [{section}] (sections: {', '.join(SCHEMA)})")
+        raise SceneError(key, f"unknown section [{section}] (sections: {', '.join(SCHEMA)})")
     if (section, name) in _RETIRED:
-        raise SceneError(_RETIRED[section, name])
+        raise SceneError(key, _RETIRED[section, name])
     if name not in SCHEMA[section]:
-        raise SceneError(f"{key}: unknown key (known in [{section}]: "
+        raise SceneError(key, f"unknown key (known in [{section}]: "
                          f"{', '.join(SCHEMA[section])})")
     data.setdefault(section, {})[name] = value
 

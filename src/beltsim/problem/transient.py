@@ -80,9 +80,10 @@ concentrated force F. With u2 = u(x2, t) from (2) at x = x2 (tau2 = t - (x2 - x1
     distributed friction = b1 (eps_in(t) - eps_in(tau2)).
 
 Coulomb: the adhesion solution's F > 0 (for every t > 0) is a traction no finite
-f* can carry, so a slip zone (x*, x2] opens from x2 at once, in which f = s f*, s = sign(v - c), and eps_x = -s f* / b1; eps is
-continuous at x* and at x2 (no concentrated force), so with e* = eps_in(tau*),
-tau* = t - (x* - x1) / c and d = x2 - x*::
+f* can carry, so a slip zone (x*, x2] opens from x2 at once, in which f = s f*,
+s = sign(v - c), and eps_x = -s f* / b1; eps is continuous at x* and at x2 (no
+concentrated force), so with e* = eps_in(tau*), tau* = t - (x* - x1) / c and
+d = x2 - x*::
 
     eps = e* - s f* (x - x*) / b1 on [x*, x2],   eps_out = e* - s f* d / b1,
     G(x*, t) = u(x*, t) + (L - x*) e* - s (f* / b1) d (d / 2 + L - x2) = 0,        (4)

@@ -229,7 +229,7 @@ class Simulation:
         for tr in trackers:
             tr.initialize(self)
         t_end = self.numerics.t_end
-        status, reason = RunStatus.REACHED_END, None
+        status, reason, failure = RunStatus.REACHED_END, None, None
         start = time.perf_counter()
         try:
             # a fixed-step scheme's t carries round-off: within 1e-9 of a check is there
@@ -257,7 +257,7 @@ class Simulation:
                     status, reason = _stop_of(tr, stop, self.t)
                     break
         except NumericalError as exc:
-            status, reason = RunStatus.FAILED, str(exc)
+            status, reason, failure = RunStatus.FAILED, str(exc), exc.kind
             if raise_on_failure:
                 raise
         finally:
@@ -266,7 +266,7 @@ class Simulation:
                 tr.finalize(self, status)
         if status is RunStatus.REACHED_END:
             reason = self.steady.not_steady(t_end)
-        return self._result(status, reason, compile_time)
+        return self._result(status, reason, compile_time, failure)
 
     def _restore(self, good):
         state, t, scheme = good
@@ -280,11 +280,11 @@ class Simulation:
         for tr in trackers:
             tr.initialize(self)
         start = time.perf_counter()
-        status, reason = RunStatus.CONVERGED, None
+        status, reason, failure = RunStatus.CONVERGED, None, None
         try:
             self.scheme.solve(self.state)
         except NumericalError as exc:
-            status, reason = RunStatus.FAILED, str(exc)
+            status, reason, failure = RunStatus.FAILED, str(exc), exc.kind
             if raise_on_failure:
                 raise
         finally:
@@ -292,11 +292,12 @@ class Simulation:
             self._measured = None
             for tr in trackers:
                 tr.finalize(self, status)
-        return self._result(status, reason, compile_time)
+        return self._result(status, reason, compile_time, failure)
 
-    def _result(self, status, reason, compile_time) -> RunResult:
+    def _result(self, status, reason, compile_time, failure=None) -> RunResult:
         return RunResult(
             scene=self.scene, numerics=self.numerics, status=status, reason=reason,
+            failure=failure,
             time_accurate=self.scheme.time_accurate,
             solution=self.solution(), simulated_time=self.t, wall_time=self.wall_time,
             compile_time=compile_time, statistics=self.scheme.statistics(),

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import FailureKind
 from ..problem import analytic
 from ..problem.drive import period_of
 from ..problem.scene import Scene
@@ -89,6 +90,8 @@ class RunResult:
     #: the exact steady solution of the same scene, attached by the caller (None: not
     #: attached, or the scene has none)
     reference: analytic.AnalyticSolution | None = None
+    #: what stopped a FAILED run (None for any other status)
+    failure: FailureKind | None = None
 
     @property
     def converged(self) -> bool:
@@ -140,7 +143,9 @@ class RunResult:
                    steps=self.steps, rejected_steps=self.statistics.get("rejected_steps", 0),
                    time_accurate=self.time_accurate, wall_time=self.wall_time,
                    compile_time=self.compile_time,
-                   reason=self.reason, elements=self.numerics.elements,
+                   reason=self.reason,
+                   failure=self.failure.value if self.failure is not None else None,
+                   elements=self.numerics.elements,
                    integrator=self.numerics.integrator, power_balance=self.power_balance,
                    periodic=self.periodic,
                    error=self.errors())

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NumericalError
+from ..errors import FailureKind, NumericalError
 from .result import RunStatus
 
 GROWTH_LIMIT = 1e4  # |u| / (|e0| L) or |theta| / |e0| beyond this counts as divergence
@@ -135,12 +135,12 @@ class DivergenceGuard(Tracker):
         gt = float(np.max(np.abs(sim.state.theta))) / s.theta
         if not (math.isfinite(gu) and math.isfinite(gt)):
             raise NumericalError(f"non-finite displacement or rotation at t = {sim.t:.6g} s",
-                                 t=sim.t, quantity="u/theta")
+                                 kind=FailureKind.NON_FINITE, t=sim.t, quantity="u/theta")
         if gu > GROWTH_LIMIT or gt > GROWTH_LIMIT:
             q, g = ("u", gu) if gu >= gt else ("theta", gt)
             raise NumericalError(
                 f"{q} grew without bound at t = {sim.t:.6g} s ({g:.3g} times its scale)",
-                t=sim.t, quantity=q)
+                kind=FailureKind.GREW, t=sim.t, quantity=q)
         return None
 
 

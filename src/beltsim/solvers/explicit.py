@@ -550,12 +550,12 @@ class ExplicitScheme(Scheme):
                              "transport stencil in the slip velocity")
         limit = explicit_stable_dt(P, grid.h_min, disc.model.damping)
         if not limit > 0.0:
-            raise SceneError("numerics.integrator: the explicit scheme has no stable step "
+            raise SceneError("numerics.integrator", "the explicit scheme has no stable step "
                              "for this scene; use the implicit integrator")
         requested = disc.scene.numerics.get("dt")
         if requested is not None and requested > limit:
             raise SceneError(
-                f"numerics.dt: {requested:.6g} s exceeds the explicit stability limit "
+                "numerics.dt", f"{requested:.6g} s exceeds the explicit stability limit "
                 f"{limit:.6g} s (von Neumann, on the smallest element, {grid.h_min:.3g} m: "
                 f"the waves of both fields with the shear, gyroscopic and friction terms)")
         dt = requested if requested is not None else EXPLICIT_SAFETY * limit
@@ -563,7 +563,7 @@ class ExplicitScheme(Scheme):
         work = steps * (grid.n_elements + 1.0)
         if work > num.max_work:
             raise SceneError(
-                f"numerics.max_work: this explicit run may need {work:.3g} node-steps "
+                "numerics.max_work", f"this explicit run may need {work:.3g} node-steps "
                 f"({steps:.3g} steps of {dt:.3g} s to t_end = {num.t_end:.4g} s, "
                 f"{grid.n_elements + 1} nodes; about {_duration(work / EXPLICIT_RATE)} at "
                 f"{EXPLICIT_RATE:.0e} node-steps/s), above max_work = {num.max_work:.3g}; "

@@ -16,7 +16,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..errors import NumericalError
+from ..errors import FailureKind, NumericalError
 from ..physics.friction import EXACT, is_exact, law, law_inverse
 from ..physics.model import add_stick_penalty, assemble, update_multipliers
 from ..problem.drive import friction_factor
@@ -402,8 +402,8 @@ class NewtonScheme(Scheme):
         if status == FAILED:
             raise NumericalError(
                 f"Newton iteration failed at t = {t:.6g} s even with the step cut to "
-                f"dt = {dt:.3g} s (residual norm {self.work.stats[0]['merit']:.3g})", t=t,
-                quantity="newton")
+                f"dt = {dt:.3g} s (residual norm {self.work.stats[0]['merit']:.3g})",
+                kind=FailureKind.NEWTON, t=t, quantity="newton")
         if status == NONFINITE:
             raise NumericalError(f"non-finite displacement or rotation at t = {t:.6g} s",
-                                 t=t, quantity="u/theta")
+                                 kind=FailureKind.NON_FINITE, t=t, quantity="u/theta")

@@ -29,7 +29,7 @@ def get(name: str) -> type:
     try:
         return _REGISTRY[name]
     except KeyError:
-        raise SceneError(f"numerics.integrator: must be one of "
+        raise SceneError("numerics.integrator", "must be one of "
                          f"{' | '.join(repr(n) for n in _REGISTRY)}, got {name!r}") from None
 
 

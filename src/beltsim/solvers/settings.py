@@ -130,14 +130,14 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
     dt = nm.get("dt", max(ramp_time, transit) / 50.0)
     t_end = nm.get("t_end", settle_time(scene, ramp_time) + 400.0 * transit)
     if dt > t_end:
-        raise SceneError(f"numerics.dt: must be <= numerics.t_end = {t_end!r}, got {dt!r}")
+        raise SceneError("numerics.dt", f"must be <= numerics.t_end = {t_end!r}, got {dt!r}")
     integrator = nm.get("integrator", "implicit")
     reason = registry.applicable(integrator, P.inertia)  # unknown names raise here
     if reason:
         raise SceneError(reason)
     if 0.0 < abs(P.e0) < MIN_MISMATCH:
         raise SceneError(
-            f"motion.surface_speed: |v/c - 1| = {abs(P.e0):.3g} is below {MIN_MISMATCH:g} "
+            "motion.surface_speed", f"|v/c - 1| = {abs(P.e0):.3g} is below {MIN_MISMATCH:g} "
             f"but not 0: in double precision v - c then carries a round-off of "
             f"{2.2e-16 / abs(P.e0):.1%} and the friction law cannot resolve it; use v = c "
             f"for the zero state")
@@ -157,7 +157,7 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         vreg = nm.get("regularisation", max(default_vreg * refine, MIN_VREG * P.c))
         law, fs = nm.get("friction_law", "tanh"), P.fstar
         if vreg < MIN_VREG * P.c:
-            raise SceneError(f"numerics.regularisation: must be >= {MIN_VREG:g} c = "
+            raise SceneError("numerics.regularisation", f"must be >= {MIN_VREG:g} c = "
                              f"{MIN_VREG * P.c:.3g} m/s (below it slip velocities drown in "
                              f"round-off), got {vreg!r}")
     else:
@@ -168,14 +168,14 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
     if "acceleration" in nm and not accelerated:
         allowed = " | ".join(f'"{n}"' for n in registry.names()
                              if registry.get(n).accelerated)
-        raise SceneError(f"numerics.acceleration: only for numerics.integrator = {allowed} "
+        raise SceneError("numerics.acceleration", f"only for numerics.integrator = {allowed} "
                          f"(the damping of a time-accurate run is physics.damping)")
     acceleration = 0.0
     if accelerated and P.inertia:
         omega1 = math.pi * P.B / (P.L * math.sqrt(P.rho * P.b1))
         acceleration = nm.get("acceleration", 2.0 * omega1)
     if "max_work" in nm and integrator != "explicit":
-        raise SceneError('numerics.max_work: only for numerics.integrator = "explicit" (the '
+        raise SceneError("numerics.max_work", 'only for numerics.integrator = "explicit" (the '
                          "other schemes' steps adapt)")
     return Numerics(
         integrator=integrator,
@@ -208,7 +208,7 @@ def check_memory(elements: int) -> None:
     """Refuse a grid whose run would not fit in the available memory."""
     need, have = MEMORY_PER_NODE * (elements + 1.0), available_memory()
     if have is not None and need > have:
-        raise SceneError(f"numerics.elements: {elements} elements need about {need / 2**30:.3g} "
+        raise SceneError("numerics.elements", f"{elements} elements need about {need / 2**30:.3g} "
                          f"GiB ({MEMORY_PER_NODE} bytes a node), more than the "
                          f"{have / 2**30:.3g} GiB this machine has available")
 

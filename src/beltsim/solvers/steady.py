@@ -12,7 +12,7 @@ discrete steady state as the transient schemes.
 
 from __future__ import annotations
 
-from ..errors import NumericalError
+from ..errors import FailureKind, NumericalError
 from ..physics.friction import is_exact
 from ..physics.model import regularised
 from ..problem.drive import Drive
@@ -69,8 +69,8 @@ class SteadyScheme(NewtonScheme):
                     max_iterations=STAGE_ITERATIONS * self.settings.max_iterations)):
                 raise NumericalError(
                     "steady semi-smooth Newton iteration of the exact friction law did not "
-                    "converge from its regularised twin's steady state", t=0.0,
-                    quantity="newton")
+                    "converge from its regularised twin's steady state",
+                    kind=FailureKind.CONTINUATION, t=0.0, quantity="newton")
 
     def _continue_in_speed(self, state) -> None:
         stage_settings = self.settings._replace(
@@ -89,5 +89,5 @@ class SteadyScheme(NewtonScheme):
                 if ds < MIN_STAGE:
                     raise NumericalError(
                         f"steady Newton iteration failed at {100 * s_done:.4g}% of the "
-                        f"speed mismatch (continuation step below {MIN_STAGE:g})", t=0.0,
-                        quantity="newton")
+                        f"speed mismatch (continuation step below {MIN_STAGE:g})",
+                        kind=FailureKind.CONTINUATION, t=0.0, quantity="newton")

@@ -24,7 +24,7 @@ from ..simulation.solution import relative_error
 
 def explicit_node_steps_per_s(scene: Scene, settle=0.05, span=0.02) -> float:
     """Node-steps per second of the explicit kernel alone, in a settled state."""
-    sim = Simulation(scene.with_overrides(["numerics.integrator=explicit"]))
+    sim = Simulation(scene.with_overrides([("numerics.integrator", "explicit")]))
     sim.warm_up()
     sim.advance(settle)
     steps0, start = sim.steps, time.perf_counter()
@@ -80,7 +80,7 @@ def run_ours(scene: Scene, repeat=3, log=print) -> tuple[dict, object, object]:
         f"{res.steps} steps, wall {res.wall_time:.4f} s, total "
         f"friction {total:.8g} N, error {out['ours_error']:.2e} (compile/cache load "
         f"{res.compile_time:.2f} s, not counted)")
-    steady = _ours(scene.with_overrides(["numerics.integrator=steady"]), repeat)
+    steady = _ours(scene.with_overrides([("numerics.integrator", "steady")]), repeat)
     out.update(ours_steady_wall_time=steady.wall_time,
                ours_steady_total_friction=steady.solution.total_friction,
                ours_steady_error=relative_error(steady.solution.total_friction, exact))

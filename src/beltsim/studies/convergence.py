@@ -38,7 +38,7 @@ def richardson(scene: Scene, reference=None):
     cell (bounded by ~7 h^2, not smooth in h): the fine grid's is kept.
     Returns (coarse result, fine result, extrapolated errors, wall time of both).
     """
-    steady = scene.with_overrides(["numerics.integrator=steady"])
+    steady = scene.with_overrides([("numerics.integrator", "steady")])
     coarse = Simulation(steady)
     r1 = coarse.run(raise_on_failure=False)
     r2 = Simulation(steady, grid=bisect(coarse.grid)).run(raise_on_failure=False)
@@ -84,7 +84,7 @@ def convergence(scene: Scene, ladder=LADDER, schemes=None, progress=None) -> lis
     nan = float("nan")
     for scheme in schemes or schemes_for(scene):
         for n in ladder:
-            sc = scene.with_overrides([f"numerics.elements={n}"])
+            sc = scene.with_overrides([("numerics.elements", n)])
             try:
                 row = _rung(sc, scheme, n, reference)
             except SceneError as exc:
@@ -102,7 +102,7 @@ def _rung(sc, scheme, n, reference) -> dict:
         return _row(scheme, n, r1.solution.grid.h_min, float("nan"), r1.steps + r2.steps,
                     r1.newton_iterations + r2.newton_iterations, wall,
                     r1.compile_time + r2.compile_time, err is not None, err)
-    sim = Simulation(sc.with_overrides([f"numerics.integrator={scheme}"]))
+    sim = Simulation(sc.with_overrides([("numerics.integrator", scheme)]))
     res = sim.run(raise_on_failure=False)
     res.reference = reference
     dt = sim.numerics.dt if sim.scheme.transient else float("nan")

@@ -25,7 +25,7 @@ def solutions() -> dict:
     out = {name: analytic.solve(paper_scene(name)) for name in CASES}
     for fs in FIG7_FSTAR:
         out[f"slip_{fs:.0e}"] = analytic.solve(
-            paper_scene("slip", [f"contact.max_friction={fs}"]))
+            paper_scene("slip", [("contact.max_friction", fs)]))
     return out
 
 
@@ -61,7 +61,7 @@ def simulate(progress=None) -> dict:
 
     out = {}
     scenes = {name: paper_scene(name) for name in CASES}
-    scenes.update({f"slip_{fs:.0e}": paper_scene("slip", [f"contact.max_friction={fs}"])
+    scenes.update({f"slip_{fs:.0e}": paper_scene("slip", [("contact.max_friction", fs)])
                    for fs in FIG7_FSTAR})
     for key, sc in scenes.items():
         res = run(sc)

@@ -2,8 +2,11 @@
 
 Each cell ends in one status, decided from structured outcomes: not applicable (the
 registry says the scheme does not apply to the scene), refused (the scene or its
-numerics break a rule before anything runs), or the status of the run (converged
-within the bounds of the transient simulator, out of bounds, not converged, diverged).
+numerics break a rule before anything runs: a SceneError), or the status of the run
+(converged within the bounds of the transient simulator, out of bounds, not converged,
+diverged: the run's RunStatus and FailureKind). A cell's ``reason_key`` says what its
+reason is about, so that alike cells count together: the key a refusal names, the kind
+of failure, the run's status, or the errors out of bounds.
 """
 
 from __future__ import annotations
@@ -13,8 +16,8 @@ import math
 from dataclasses import dataclass
 
 from .. import solvers
-from ..errors import BeltsimError
-from ..problem.scene import shipped_scene
+from ..errors import BeltsimError, SceneError
+from ..problem.scene import Scene, shipped_scene
 from ..simulation.controller import Simulation
 from ..simulation.result import RunStatus, reference_of
 from .convergence import ERROR_KEYS
@@ -24,7 +27,7 @@ BOUNDS = {"total_friction": 5e-3, "u": 2e-2, "theta": 2e-2, "concentrated_force"
           "slip_start": 5e-3}
 
 
-class CellStatus(str, enum.Enum):
+class CellStatus(enum.StrEnum):
     CONVERGED = "converged"
     BOUNDED = "bounded"  # a fixed span of simulated time: finite and bounded throughout
     OUT_OF_BOUNDS = "out of bounds"
@@ -45,17 +48,18 @@ ACCEPTED = (CellStatus.CONVERGED, CellStatus.BOUNDED, CellStatus.REFUSED,
 #: of at least 1e-3 per radian of the mode's oscillation and per transit (far above
 #: the eigensolver's round-off, measured 1e-9 relative between dense and shift-invert).
 GROWTH_MARGIN = 1e-3
-#: Run failures that are divergence (the state grew), not a solver's failure to step.
-_DIVERGENCE = ("grew without bound", "non-finite")
 _RUN_STATUS = {RunStatus.FAILED: CellStatus.DIVERGED, RunStatus.REACHED_END:
                CellStatus.NOT_CONVERGED, RunStatus.INTERRUPTED: CellStatus.NOT_CONVERGED}
 
 
 @dataclass(frozen=True)
 class Case:
+    """A scene of the matrix: a base scene and (key, value) overrides of it."""
+
     name: str
-    base: str  # a shipped scene (problem.scene.scene_names)
-    overrides: tuple[str, ...] = ()
+    #: a shipped scene by name (problem.scene.scene_names), or a Scene
+    base: str | Scene
+    overrides: tuple[tuple[str, object], ...] = ()
     #: run over this span of simulated time and ask only that the state stay bounded
     #: (an undamped belt rings for long, a fluttering one grows into a limit cycle; no
     #: steady state is expected within the span)
@@ -64,74 +68,87 @@ class Case:
     @property
     def sets_grid(self) -> bool:
         """Whether the case is about the grid itself (a coarse matrix leaves it out)."""
-        return any(o.startswith("numerics.elements=") for o in self.overrides)
+        return any(key == "numerics.elements" for key, _ in self.overrides)
+
+    def scene(self, extra=()) -> Scene:
+        """The case's scene with ``extra`` (key, value) overrides; raises SceneError when
+        they break a rule, MissingInputError when a shipped base is not installed."""
+        base = shipped_scene(self.base) if isinstance(self.base, str) else self.base
+        span = [("numerics.t_end", self.span)] if self.span else []
+        return base.with_overrides([*self.overrides, *span, *extra])
 
 
-_THIN = ("beam.height=0.01",)
-_OUTLET = ("contact.start=0.6466666666666666", "contact.end=0.98")
+_THIN = (("beam.height", 0.01),)
+_OUTLET = (("contact.start", 0.6466666666666666), ("contact.end", 0.98))
 #: Each derived from the paper's data.
 STABILITY_CASES = (
     Case("paper quasistatic", "paper_quasistatic"),
     Case("paper inertia", "paper_inertia"),
     Case("paper slip", "paper_slip"),
     Case("stiff friction (v_reg 1e-5, f* 1e8)", "paper_slip",
-         ("contact.max_friction=1e8", "numerics.regularisation=1e-5")),
-    Case("stiff belt (E x 100)", "paper_slip", ("beam.youngs_modulus=5e9",)),
+         (("contact.max_friction", 1e8), ("numerics.regularisation", 1e-5))),
+    Case("stiff belt (E x 100)", "paper_slip", (("beam.youngs_modulus", 5e9),)),
     Case("thin belt (h = 0.01 m)", "paper_slip", _THIN),
-    Case("thin belt, quasistatic", "paper_slip", _THIN + ("physics.inertia=false",)),
+    Case("thin belt, quasistatic", "paper_slip", _THIN + (("physics.inertia", False),)),
     Case("near-critical (c = 0.97 sqrt(a/I))", "paper_slip",
-         ("motion.belt_speed=125.2265", "motion.surface_speed=126.4787")),
-    Case("large mismatch (v/c - 1 = 0.05)", "paper_slip", ("motion.surface_speed=126",)),
-    Case("v = c (zero state)", "paper_slip", ("motion.surface_speed=120",)),
-    Case("v < c (reversed forces)", "paper_slip", ("motion.surface_speed=118.8",)),
+         (("motion.belt_speed", 125.2265), ("motion.surface_speed", 126.4787))),
+    Case("large mismatch (v/c - 1 = 0.05)", "paper_slip", (("motion.surface_speed", 126.0),)),
+    Case("v = c (zero state)", "paper_slip", (("motion.surface_speed", 120.0),)),
+    Case("v < c (reversed forces)", "paper_slip", (("motion.surface_speed", 118.8),)),
     Case("short contact (x2 - x1 = 0.02 L)", "paper_slip",
-         ("contact.start=0.49", "contact.end=0.51")),
+         (("contact.start", 0.49), ("contact.end", 0.51))),
     # at the paper's 39 1/s this geometry flutters (a 200 Hz slip-zone mode grows,
     # README): damped above ~130 1/s it settles; at 39 1/s it runs a span
     Case("contact ends 0.02 L from the outlet (d = 200 1/s)", "paper_slip",
-         (*_OUTLET, "physics.damping=200")),
+         (*_OUTLET, ("physics.damping", 200.0))),
     Case("contact ends 0.02 L from the outlet, d = 39 1/s: flutter", "paper_slip", _OUTLET,
          span=0.1),
-    Case("very fine grid (20,000 elements)", "paper_slip", ("numerics.elements=20000",)),
+    Case("very fine grid (20,000 elements)", "paper_slip", (("numerics.elements", 20000),)),
     Case("soft belt (E / 100: c above both critical speeds)", "paper_slip",
-         ("beam.youngs_modulus=5e5",)),
+         (("beam.youngs_modulus", 5e5),)),
     Case("soft belt (E / 100), quasistatic", "paper_slip",
-         ("beam.youngs_modulus=5e5", "physics.inertia=false")),
-    Case("poisson_ratio -0.99", "paper_slip", ("beam.poisson_ratio=-0.99",)),
-    Case("poisson_ratio 0.499", "paper_slip", ("beam.poisson_ratio=0.499",)),
-    Case("tiny mismatch (v/c - 1 = 1e-6)", "paper_slip", ("motion.surface_speed=120.00012",)),
-    Case("the whole contact slides (f* = 5e3)", "paper_slip", ("contact.max_friction=5e3",)),
+         (("beam.youngs_modulus", 5e5), ("physics.inertia", False))),
+    Case("poisson_ratio -0.99", "paper_slip", (("beam.poisson_ratio", -0.99),)),
+    Case("poisson_ratio 0.499", "paper_slip", (("beam.poisson_ratio", 0.499),)),
+    Case("tiny mismatch (v/c - 1 = 1e-6)", "paper_slip", (("motion.surface_speed", 120.00012),)),
+    Case("the whole contact slides (f* = 5e3)", "paper_slip", (("contact.max_friction", 5e3),)),
     Case("very slow belt (c = 1e-3 m/s)", "paper_slip",
-         ("motion.belt_speed=1e-3", "motion.surface_speed=1.01e-3")),
+         (("motion.belt_speed", 1e-3), ("motion.surface_speed", 1.01e-3))),
     Case("long domain (L = 50 m)", "paper_slip",
-         ("beam.length=50", "contact.start=16.666666666666668",
-          "contact.end=33.333333333333336")),
+         (("beam.length", 50.0), ("contact.start", 16.666666666666668),
+          ("contact.end", 33.333333333333336))),
     Case("contact starts 0.02 L from the inlet", "paper_slip",
-         ("contact.start=0.02", "contact.end=0.3533333333333333")),
-    Case("paper slip, undamped", "paper_slip", ("physics.damping=0",), span=0.1),
-    Case("paper inertia, undamped", "paper_inertia", ("physics.damping=0",), span=0.1),
+         (("contact.start", 0.02), ("contact.end", 0.3533333333333333))),
+    Case("paper slip, undamped", "paper_slip", (("physics.damping", 0.0),), span=0.1),
+    Case("paper inertia, undamped", "paper_inertia", (("physics.damping", 0.0),), span=0.1),
 )
 
 
-def stability_cell(case: Case, scheme: str, extra=()) -> dict:
-    """One cell: status, reason, dt, steps, wall time and errors of one scheme on one case."""
-    cell = {"scheme": scheme, "status": "", "reason": "", "dt": float("nan"), "steps": 0,
-            "wall_time": float("nan"), **{f"error_{k}": float("nan") for k in ERROR_KEYS}}
-    span = [f"numerics.t_end={case.span}"] if case.span else []
-    base = shipped_scene(case.base)  # a missing base scene fails the study, not the cell
+def stability_cell(case: Case, scheme: str, extra=(), bounds=None) -> dict:
+    """One cell: status, reason, reason_key, dt, steps, wall time and errors of one scheme
+    on one case; ``extra``: (key, value) overrides of every case (e.g. the grid),
+    ``bounds``: the acceptance bounds (default BOUNDS).
+
+    A shipped base scene that is not installed raises MissingInputError: a missing input
+    fails the study, it is never a refused cell.
+    """
+    cell = {"scheme": scheme, "status": "", "reason": "", "reason_key": "",
+            "dt": float("nan"), "steps": 0, "wall_time": float("nan"),
+            **{f"error_{k}": float("nan") for k in ERROR_KEYS}}
     try:
-        scene = base.with_overrides([*case.overrides, *span, *extra])
-    except BeltsimError as exc:
-        cell.update(status=CellStatus.REFUSED, reason=str(exc))
+        scene = case.scene(extra)
+    except SceneError as exc:
+        cell.update(status=CellStatus.REFUSED, reason=str(exc), reason_key=exc.key or "")
         return cell
     why_not = solvers.applicable(scheme, scene.params.inertia)
     if why_not:
         cell.update(status=CellStatus.NOT_APPLICABLE, reason=why_not)
         return cell
     try:
-        sim = Simulation(scene.with_overrides([f"numerics.integrator={scheme}"]))
+        sim = Simulation(scene.with_overrides([("numerics.integrator", scheme)]))
     except BeltsimError as exc:
-        cell.update(status=CellStatus.REFUSED, reason=str(exc))
+        key = exc.key if isinstance(exc, SceneError) else type(exc).__name__
+        cell.update(status=CellStatus.REFUSED, reason=str(exc), reason_key=key or "")
         return cell
     res = sim.run(raise_on_failure=False)
     res.reference = reference_of(scene)
@@ -145,9 +162,10 @@ def stability_cell(case: Case, scheme: str, extra=()) -> dict:
                     reason=f"t = {res.simulated_time:.3g} s, final rate "
                            f"{res.history['rate'][-1]:.3g}")
     elif not res.converged:
-        cell.update(status=_RUN_STATUS[res.status], reason=res.reason)
-        diverged = (res.status is RunStatus.FAILED
-                    and any(d in (res.reason or "") for d in _DIVERGENCE))
+        # what stopped the run: the kind of failure, else the status it ended in
+        cell.update(status=_RUN_STATUS[res.status], reason=res.reason,
+                    reason_key=(res.failure or res.status).value)
+        diverged = res.failure is not None and res.failure.diverged
         if (sim.scheme.time_accurate and scene.params.inertia
                 and (diverged or res.status is RunStatus.REACHED_END)):
             unstable, why, decay = steady_state_stability(scene)
@@ -161,16 +179,17 @@ def stability_cell(case: Case, scheme: str, extra=()) -> dict:
                 # damped and stable, but its slowest mode cannot decay to steady_tol within
                 # t_end: the physics is slower than the default span, not a numerical
                 # failure (an undamped scene rings on: the random study's own rule)
-                cell.update(status=CellStatus.BOUNDED, reason=(
+                cell.update(status=CellStatus.BOUNDED, reason_key="", reason=(
                     f"stable but slow: settling to steady_tol {num.steady_tol:g} takes about "
                     f"{needed:.3g} s after the drive (ln(1/steady_tol) over the decay rate), "
                     f"more than t_end leaves ({span:.3g} s); raise "
                     f"numerics.t_end; {cell['reason']}"))
     else:
-        over = [f"{k} {err[k]:.3g} > {b:g}" for k, b in BOUNDS.items()
-                if err.get(k) is not None and not err[k] <= b]
+        over = {k: b for k, b in (bounds or BOUNDS).items()
+                if err.get(k) is not None and not err[k] <= b}
         cell.update(status=CellStatus.OUT_OF_BOUNDS if over else CellStatus.CONVERGED,
-                    reason="; ".join(over))
+                    reason="; ".join(f"{k} {err[k]:.3g} > {b:g}" for k, b in over.items()),
+                    reason_key=", ".join(over))
     return cell
 
 
@@ -180,13 +199,27 @@ def steady_state_stability(scene) -> tuple[bool, str, float]:
     and the least stable mode's decay rate (1/s; 0 when it grows or is unknown)."""
     from ..physics.modes import steady_scene
 
-    key = steady_scene(scene).to_toml()  # the time-stepping keys do not change the verdict
+    # the time-stepping keys and the title do not change the verdict
+    data = steady_scene(scene).to_dict()
+    data.pop("title", None)
+    key = _frozen(data)
     if key not in _VERDICTS:
         _VERDICTS[key] = _stability_verdict(scene)
     return _VERDICTS[key]
 
 
-_VERDICTS: dict[str, tuple[bool, str, float]] = {}  # per scene: implicit, explicit share it
+#: Verdicts by the scene's data (:func:`_frozen`): the schemes of a case share one.
+_VERDICTS: dict[tuple, tuple[bool, str, float]] = {}
+
+
+def _frozen(value):
+    """A scene's data as a hashable value: tables as sorted (key, value) tuples, arrays
+    (a drive's rows) as tuples."""
+    if isinstance(value, dict):
+        return tuple(sorted((k, _frozen(v)) for k, v in value.items()))
+    if isinstance(value, list):
+        return tuple(_frozen(v) for v in value)
+    return value
 
 
 def _stability_verdict(scene) -> tuple[bool, str, float]:
