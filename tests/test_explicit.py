@@ -240,7 +240,7 @@ def _explicit_step_numpy(d, u, th, va, wa, db, t, dt):
         kb = dt * (1 / m[j] + hh * hh / mi[j])
 
         def force(vhat, j=j):
-            return -wf[j] * p.friction_scale * law_numpy(p.law, vhat / p.v_reg)[0]
+            return -wf[j] * p.friction_scale * law_numpy(p.law, vhat / p.regularisation)[0]
 
         def slip(vhat, j=j, kb=kb):  # the slip velocity's estimate, given the force
             dj = delta[j] + kb * force(vhat)

@@ -142,11 +142,11 @@ def _continuous_loads(sim, gyro="exact"):
         ph, dph, ddph = _phi(t)
         vrel = (u0 + hh * t0) * dph + c * (u1 + hh * t1) * ph - mismatch(d.drive, t)
         f = contact * -p.friction_scale * friction_factor(d.drive, t) * law_numpy(
-            p.law, vrel / p.v_reg)[0]
+            p.law, vrel / p.regularisation)[0]
         qu = (p.mass * (u0 * ddph + 2 * c * gu * dph + p.damping * u0 * dph)
-              - p.tension_eff * u2 * ph - f)
+              - p.B * u2 * ph - f)
         qt = (p.rotary_inertia * (t0 * ddph + 2 * c * gt * dph + p.damping * t0 * dph)
-              - p.bending_eff * t2 * ph + p.shear * t0 * ph - hh * f)
+              - p.A * t2 * ph + p.shear * t0 * ph - hh * f)
         return qu, qt
 
     times = np.linspace(0.0, SPAN, TABLE)

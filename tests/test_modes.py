@@ -54,7 +54,7 @@ def test_the_linearisation_is_the_numpy_twins_derivative(scene):
     old = State(st.u, st.theta, st.lam, np.zeros(N + 1), np.zeros(N + 1), np.zeros(N + 1))
     drive = Drive.constant(P.v - P.c)
     # a step small against the regularisation (the friction's slope changes over v_reg)
-    step = 1e-4 * disc.numerics.vreg * disc.grid.he.min() / P.c
+    step = 1e-4 * disc.numerics.regularisation * disc.grid.he.min() / P.c
     M, C, K = modes.linearisation(disc, st)
     s1 = 50.0
     for s in (0.0, s1):

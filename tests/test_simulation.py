@@ -111,7 +111,7 @@ def test_friction_law_across_stick_and_slip(speed, sign):
     # local rate left at steady_tol (~1e-7 m/s) matters: in stick the law's slope
     # f*/v_reg ~ 1e9 N/m per m/s turns it into tens of N/m
     vrel = ub_t[j] + P.c * strain_numpy(ub, sol.sw, j) - (P.v - P.c)
-    expected = -P.fstar * law_numpy(num.law_code, vrel / num.vreg)[0]
+    expected = -P.fstar * law_numpy(num.law_code, vrel / num.regularisation)[0]
     f = sol.traction[j]
     np.testing.assert_allclose(f, expected, rtol=1e-6, atol=1e-6 * P.fstar)
     # x* lies in the control volume [x_{j-1/2}, x_{j+1/2}] of one partly stuck node
@@ -121,7 +121,7 @@ def test_friction_law_across_stick_and_slip(speed, sign):
     # sliding: traction at the limit, with the sign of v - c; sticking: below the limit
     np.testing.assert_allclose(f[sliding], sign * P.fstar, rtol=1e-6)
     assert np.all(np.abs(f[sticking]) < 0.99 * P.fstar)
-    assert np.all(np.abs(vrel[sticking]) < 3 * num.vreg)
+    assert np.all(np.abs(vrel[sticking]) < 3 * num.regularisation)
     assert sliding.sum() > 5 and sticking.sum() > 100
 
 
