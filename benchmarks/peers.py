@@ -29,9 +29,9 @@ from typing import NamedTuple
 import numpy as np
 
 from beltsim.errors import SceneError
-from beltsim.physics.friction import is_exact, law_numpy
-from beltsim.physics.model import forces_numpy, strain_numpy
-from beltsim.problem.drive import Drive, friction_factor, mismatch
+from beltsim.physics import reference
+from beltsim.physics.friction import is_exact
+from beltsim.problem.drive import Drive
 from beltsim.simulation.controller import Simulation
 from beltsim.solvers.newton import ROUNDOFF_FLOOR
 
@@ -71,183 +71,146 @@ class PeerResult(NamedTuple):
 
 
 class FixedPattern:
-    """A CSC matrix of fixed pattern: constant entries plus entries that change per call.
+    """A CSC matrix of fixed pattern: a weighted sum of constant matrices plus entries that
+    change per call.
 
     What a careful scipy user does to keep scipy.sparse's bookkeeping (pattern merging,
     index checks) out of every Jacobian: the pattern and the slots of the changing
-    entries are found once; a call copies the constant values and adds the others,
-    ``values[take] * scale`` of the ``values`` it is given.
+    entries are found once; a call sums the constant parts with its weights and adds
+    ``values[take] * scale`` of the ``values`` it is given (entries in one slot add).
     """
 
-    def __init__(self, shape, rows, cols, vals, var_rows, var_cols, take, scale):
+    def __init__(self, shape, parts, var_rows, var_cols, take=None, scale=1.0):
         nr = shape[0]
-        key_c = cols.astype(np.int64) * nr + rows
+        keys_c = [cols.astype(np.int64) * nr + rows for rows, cols, _ in parts]
         key_v = var_cols.astype(np.int64) * nr + var_rows
-        keys = np.unique(np.concatenate([key_c, key_v]))
-        self.shape, self._take, self._scale = shape, take, scale
-        self._base = np.zeros(keys.size)
-        np.add.at(self._base, np.searchsorted(keys, key_c), vals)
+        keys = np.unique(np.concatenate([*keys_c, key_v]))
+        self.shape = shape
+        self._take = np.arange(key_v.size) if take is None else take
+        self._scale = scale
+        self._base = np.zeros((len(parts), keys.size))
+        for base, key, (_, _, vals) in zip(self._base, keys_c, parts):
+            np.add.at(base, np.searchsorted(keys, key), vals)
         self._slot = np.searchsorted(keys, key_v)
-        if np.unique(self._slot).size != self._slot.size:
-            raise ValueError("the changing entries must sit in distinct slots")
         self._indices = (keys % nr).astype(np.int32)
         counts = np.bincount(keys // nr, minlength=shape[1])
         self._indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
 
-    def matrix(self, values):
+    def matrix(self, values, weights=(1.0,)):
         from scipy.sparse import csc_matrix
 
-        data = self._base.copy()
-        data[self._slot] += values[self._take] * self._scale
+        data = np.asarray(weights, dtype=float) @ self._base
+        data += np.bincount(self._slot, values[self._take] * self._scale,
+                            minlength=data.size)
         return csc_matrix((data, self._indices, self._indptr), shape=self.shape)
 
 
-class PeerModel:
-    """The semi-discrete forces and their analytic sparse Jacobian, interior nodes only.
+def coo_parts(matrix, row_scale=None, row_offset=0, columns=None):
+    """(rows, cols, vals) of a sparse matrix's entries in its first ``columns`` columns,
+    each row times ``row_scale`` and moved down by ``row_offset``."""
+    m = matrix.tocoo()
+    keep = m.col < (m.shape[1] if columns is None else columns)
+    rows, cols, vals = m.row[keep], m.col[keep], m.data[keep]
+    if row_scale is not None:
+        vals = vals * row_scale[rows]
+    return rows + row_offset, cols, vals
 
-    The boundary nodes 0 and N are held at zero, so their columns drop out. Unknown
-    order: (u, theta, u_t, theta_t), n = N - 1 values each. The Jacobian is a constant
-    part (elastic, shear, gyroscopic and damping terms) plus the friction's, which
-    depends on the state through the slope of the friction law.
+
+class PeerModel:
+    """The semi-discrete forces and their sparse Jacobian (:mod:`beltsim.physics.reference`).
+
+    The boundary nodes 0 and N are held at zero, so their columns drop out. Unknowns
+    y = (q, q'), q = (u_1, theta_1, u_2, ...) the n = N - 1 interior nodes interleaved
+    (the reference's order). The Jacobian is a constant part (elastic, shear,
+    gyroscopic and damping terms) plus the friction's, which depends on the state
+    through the slope of the friction law.
     """
 
     def __init__(self, sim: Simulation):
-        from scipy.sparse import bmat, diags
+        from scipy.sparse import hstack
 
         self.disc = d = sim.disc
         self.scales = d.scales
-        p, he, hb = d.model, d.mesh.he, d.mesh.hb
+        p = d.model
         if is_exact(p.law):  # y' = f(y) needs a single-valued law
             raise SceneError('numerics.friction_law: the peers take the regularised laws, '
                              'not "exact" (a method-of-lines right-hand side is single-valued)')
         N = d.grid.n_elements
-        self.n = n = N - 1
+        self.n = N - 1
         self._full = [np.zeros(N + 1) for _ in range(4)]
-        lo, hi = 1.0 / he[:-1], 1.0 / he[1:]  # 1/h_{j-1}, 1/h_j at interior nodes j
-        second = diags([lo[1:], -(lo + hi), hi[:-1]], [-1, 0, 1])
-        hbi = hb[1:-1]
-        gyro = 2.0 * p.speed * hbi * lo  # the upwind 2 c u_xt: g_j (v_j - v_{j-1})
-        upwind = diags([gyro, -gyro[1:]], [0, -1])
-        fu_ud = -p.mass * upwind - diags(p.damping * p.mass * hbi)
-        ft_th = p.bending_eff * second - diags(p.shear * hbi)
-        ft_td = -p.rotary_inertia * upwind - diags(p.damping * p.rotary_inertia * hbi)
-        self.static = bmat([[p.tension_eff * second, None, fu_ud, None],
-                            [None, ft_th, None, ft_td]], format="coo")
-        # friction: node j's force F_j(v_rel) with v_rel = u_t,j + hh theta_t,j
-        # + c sum_o sw[j, o] u_b,{j-2+o} (physics.model.contact_stencil) enters the u row
-        # of j and, times hh, its theta row
-        m = d.mesh
-        j = np.arange(m.c0, m.j2 + 1)
-        self.contact = j
-        hh, c = p.half_height, p.speed
-        i = j - 1
-        cols, dvrel = [2 * n + i, 3 * n + i], [np.ones(j.size), np.full(j.size, hh)]
-        for o in range(4):
-            k = i - 2 + o  # interior index of node j - 2 + o
-            w = np.where((k >= 0) & (k < n), c * m.sw[j, o], 0.0)
-            cols += [k, n + k]
-            dvrel += [w, hh * w]
-        cols, dvrel = np.stack(cols), np.stack(dvrel)
-        keep = (cols >= 0) & (cols < 4 * n) & (dvrel != 0.0)
-        self.fric_cols = np.concatenate([cols[keep], cols[keep]])
-        self.fric_rows = np.concatenate([np.broadcast_to(i, cols.shape)[keep],
-                                         np.broadcast_to(n + i, cols.shape)[keep]])
-        self._fnode = np.concatenate([np.broadcast_to(np.arange(j.size), cols.shape)[keep]] * 2)
-        self._fcoef = np.concatenate([dvrel[keep], hh * dvrel[keep]])
-        self._wf = m.wf[j]
+        self.operators = ops = reference.operators(d.mesh, p)
+        # -df/d(q, q') without friction, and where friction enters it
+        self.static = hstack([ops.stiffness, ops.damping]).tocsr()
+        self.friction = reference.friction_pattern(d.mesh, p)
 
     def unpack(self, y):
-        """Full nodal arrays (boundary zeros) of the interior values in y; rates absent
-        from y (the steady problem's (u, theta)) are zero."""
-        n = self.n
-        for k in range(len(y) // n):
-            self._full[k][1:-1] = y[k * n:(k + 1) * n]
-        for k in range(len(y) // n, 4):
-            self._full[k][:] = 0.0
+        """Full nodal arrays u, theta, u_t, theta_t (boundary zeros) of the values in y;
+        rates absent from y (the steady problem's q) are zero."""
+        n2 = 2 * self.n
+        for k in range(4):
+            part = y[(k // 2) * n2:(k // 2 + 1) * n2]
+            self._full[k][1:-1] = part[k % 2::2] if part.size else 0.0
         return self._full
 
     def forces(self, t, y, drive=None, p=None):
-        """forces_numpy of the state y (u, theta, and optionally u_t, theta_t)."""
+        """(f, F): the forces f (2n, interleaved) of the state y and the nodal frictions."""
         d = self.disc
-        u, th, ud, td = self.unpack(y)
-        return forces_numpy(u, th, ud, td, t, d.mesh, p or d.model, drive or d.drive)
+        f, F = reference.forces(*self.unpack(y), t, d.mesh, p or d.model, drive or d.drive)
+        return f.ravel(), F
 
     def friction_entries(self, t, y, drive=None, p=None):
-        """The friction's Jacobian entries at (fric_rows, fric_cols) of the state y."""
+        """The friction's entries of -df/d(q, q') at the pattern ``self.friction``."""
         d = self.disc
         p, drive = p or d.model, drive or d.drive
-        u, th, ud, td = self.unpack(y)
-        j, hh, c = self.contact, p.half_height, p.speed
-        ub = u + hh * th
-        vrel = ud[j] + hh * td[j] + c * strain_numpy(ub, d.mesh.sw, j) - mismatch(drive, t)
-        fs = p.friction_scale * friction_factor(drive, t)
-        slope = law_numpy(p.law, vrel / p.v_reg)[1]
-        k = self._wf * fs * slope / p.v_reg  # -dF_j/dv_rel
-        return -k[self._fnode] * self._fcoef
-
-    def force_jacobian(self, t, y, drive=None, p=None):
-        """d(force on u, moment on theta)/d(u, theta, u_t, theta_t), (2n, 4n) CSR."""
-        from scipy.sparse import coo_matrix
-
-        fric = coo_matrix((self.friction_entries(t, y, drive, p),
-                           (self.fric_rows, self.fric_cols)), shape=self.static.shape)
-        return (self.static + fric).tocsr()
+        vrel = reference.slip_velocity(*self.unpack(y), t, d.mesh, p, drive)
+        _, k = reference.friction(vrel, t, d.mesh, p, drive)
+        return k[self.friction.node] * self.friction.coef
 
     def pattern(self, row_scale, columns=4, row_offset=0, extra=None):
-        """A :class:`FixedPattern` of the force Jacobian's first ``columns`` blocks of n
-        columns, rows scaled by ``row_scale`` and moved down by ``row_offset``; ``extra``
-        (rows, cols, vals) adds constant entries. Its ``matrix`` takes the values of
+        """A :class:`FixedPattern` of df/d(q, q') (first ``columns`` blocks of n columns),
+        rows scaled by ``row_scale`` and moved down by ``row_offset``; ``extra`` (rows,
+        cols, vals) adds constant entries. Its ``matrix`` takes the values of
         :meth:`friction_entries`."""
-        s, width = self.static, columns * self.n
-        keep = s.col < width
-        rows, cols, vals = s.row[keep], s.col[keep], s.data[keep] * row_scale[s.row[keep]]
-        take = np.flatnonzero(self.fric_cols < width)
-        fr = self.fric_rows[take]
+        width, fr = columns * self.n, self.friction
+        part = coo_parts(self.static, -row_scale, row_offset, width)
         if extra is not None:
-            rows = np.concatenate([rows + row_offset, extra[0]])
-            cols = np.concatenate([cols, extra[1]])
-            vals = np.concatenate([vals, extra[2]])
-        else:
-            rows = rows + row_offset
+            part = tuple(np.concatenate(x) for x in zip(part, extra))
+        take = np.flatnonzero(fr.cols < width)
         shape = (2 * self.n + row_offset, width)
-        return FixedPattern(shape, rows, cols, vals, fr + row_offset, self.fric_cols[take],
-                            take, row_scale[fr])
+        return FixedPattern(shape, [part], fr.rows[take] + row_offset, fr.cols[take], take,
+                            -row_scale[fr.rows[take]])
 
 
 class PeerSystem(PeerModel):
-    """y' = f(t, y) with y = (u, theta, u_t, theta_t) at the interior nodes."""
+    """y' = f(t, y) with y = (q, q') at the interior nodes."""
 
     def __init__(self, sim: Simulation):
         if not sim.params.inertia:
             raise ValueError("the method-of-lines peer needs an inertial scene")
         super().__init__(sim)
-        d, n = self.disc, self.n
-        self.m = d.params.rho * d.mesh.hb[1:-1]
-        self.mi = d.params.I * d.mesh.hb[1:-1]
-        drift = np.arange(2 * n)  # (u, theta)' = (u_t, theta_t)
-        self._pattern = self.pattern(np.concatenate([1.0 / self.m, 1.0 / self.mi]),
-                                     row_offset=2 * n,
-                                     extra=(drift, drift + 2 * n, np.ones(2 * n)))
+        n2 = 2 * self.n
+        self.m = self.operators.mass
+        drift = np.arange(n2)  # q' = q'
+        self._pattern = self.pattern(1.0 / self.m, row_offset=n2,
+                                     extra=(drift, drift + n2, np.ones(n2)))
 
     def rhs(self, t, y):
-        fu, ft, _ = self.forces(t, y)
-        n = self.n
-        return np.concatenate([y[2 * n:3 * n], y[3 * n:], fu / self.m, ft / self.mi])
+        f, _ = self.forces(t, y)
+        return np.concatenate([y[2 * self.n:], f / self.m])
 
     def jacobian(self, t, y):
         """df/dy, (4n, 4n) CSC (what Radau and BDF factorise)."""
         return self._pattern.matrix(self.friction_entries(t, y))
 
-    def friction(self, t, y):
-        return self.forces(t, y)[2].sum()
+    def total_friction(self, t, y):
+        return self.forces(t, y)[1].sum()
 
 
 def _state_scale(sim: Simulation, n: int) -> np.ndarray:
     """Scale of each unknown: u, theta (as Newton's norms) and their rates (c times them)."""
     P, sc = sim.params, sim.disc.scales
     vel = P.c * sc.theta
-    return np.concatenate([np.full(n, sc.u), np.full(n, sc.theta), np.full(n, vel),
-                           np.full(n, vel / P.L)])
+    return np.concatenate([np.tile([sc.u, sc.theta], n), np.tile([vel, vel / P.L], n)])
 
 
 def run_transient_peer(sim: Simulation, method: str = "Radau", rtol: float | None = None,
@@ -287,8 +250,9 @@ def run_transient_peer(sim: Simulation, method: str = "Radau", rtol: float | Non
             while k * check <= solver.t and not converged:
                 t = k * check
                 y = dense(t)
-                total = sysm.friction(t, y)
-                rate = max(np.abs(y[2 * n:3 * n]).max(), P.L * np.abs(y[3 * n:]).max()) / vel
+                total = sysm.total_friction(t, y)
+                rates = y[2 * n:]
+                rate = max(np.abs(rates[0::2]).max(), P.L * np.abs(rates[1::2]).max()) / vel
                 converged = steady.update(t, rate, total)
                 k += 1
             if converged:
@@ -321,17 +285,16 @@ def run_steady_peer(sim: Simulation, stage_factor: float = 5.0, inner_tol: float
     model = PeerModel(sim)
     n = model.n
     drive = Drive.constant(P.v - P.c)
-    row_scale = np.concatenate([np.full(n, sc.force), np.full(n, sc.moment)])
+    row_scale = np.tile([sc.force, sc.moment], n)
     jac = model.pattern(1.0 / row_scale, columns=2)
     x_scale = _state_scale(sim, n)[:2 * n]
     tol = num.newton_tol
-    target = d.model.v_reg
+    target = d.model.regularisation
     x = np.zeros(2 * n)
     iterations = factorisations = evaluations = 0
 
     def residual(x, p):
-        fu, ft, _ = model.forces(0.0, x, drive, p)
-        return np.concatenate([fu, ft]) / row_scale
+        return model.forces(0.0, x, drive, p)[0] / row_scale
 
     def solve_stage(x, p, stage_tol):
         nonlocal iterations, factorisations, evaluations
@@ -366,26 +329,26 @@ def run_steady_peer(sim: Simulation, stage_factor: float = 5.0, inner_tol: float
         return None
 
     factor, converged, reason = stage_factor, False, "steady"
-    done = v_reg = max(target, abs(P.v - P.c))
+    done = regularisation = max(target, abs(P.v - P.c))
     first = True
     while True:
-        trial = solve_stage(x, d.model._replace(v_reg=v_reg),
-                            tol if v_reg <= target else inner_tol)
+        trial = solve_stage(x, d.model._replace(regularisation=regularisation),
+                            tol if regularisation <= target else inner_tol)
         if trial is not None:
-            x, done, first = trial, v_reg, False
-            if v_reg <= target:
+            x, done, first = trial, regularisation, False
+            if regularisation <= target:
                 converged = True
                 break
         elif first:
-            reason = f"Newton failed at v_reg = {v_reg:.3g} m/s"
+            reason = f"Newton failed at v_reg = {regularisation:.3g} m/s"
             break
         else:
             factor = math.sqrt(factor)
             if factor < 1.01:
                 reason = f"Newton failed below v_reg = {done:.3g} m/s"
                 break
-        v_reg = max(target, done / factor)
-    total = float(model.forces(0.0, x, drive)[2].sum())
+        regularisation = max(target, done / factor)
+    total = float(model.forces(0.0, x, drive)[1].sum())
     wall = time.perf_counter() - start
     return PeerResult(total, wall, converged, reason, tol, None, evaluations, iterations,
                       factorisations, iterations)

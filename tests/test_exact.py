@@ -12,7 +12,8 @@ import pytest
 
 import beltsim
 from beltsim.physics.friction import ADHESION, EXACT
-from beltsim.physics.model import mesh_of, strain_numpy
+from beltsim.physics.model import mesh_of
+from beltsim.physics.reference import strain
 from beltsim.problem.scene import Scene
 from beltsim.solvers.explicit import _friction_scalar
 from beltsim.solvers.ssn import Saddle, saddle_factor, saddle_substitute
@@ -34,7 +35,7 @@ def _slip_velocity(result):
     mesh = mesh_of(sol.grid)
     j = np.arange(mesh.c0, mesh.j2 + 1)
     ub = sol.u + 0.5 * P.h * sol.theta
-    return j, mesh, P.c * strain_numpy(ub, mesh.sw, j) - (P.v - P.c)
+    return j, mesh, P.c * strain(ub, mesh.sw, j) - (P.v - P.c)
 
 
 def test_the_coulomb_law_holds_exactly_at_every_friction_node():
@@ -90,9 +91,9 @@ def test_the_regularised_law_tends_to_the_exact_one():
     base = ["numerics.integrator=steady", "numerics.elements=200"]
     exact = _run("paper_slip", *base).solution.total_friction
     gaps = []
-    for vreg in (1e-3, 1e-4, 1e-5):
+    for regularisation in (1e-3, 1e-4, 1e-5):
         scene = Scene.load(scene_path("paper_slip")).with_overrides(
-            [*base, f"numerics.regularisation={vreg}"])
+            [*base, f"numerics.regularisation={regularisation}"])
         gaps.append(abs(beltsim.run(scene).solution.total_friction - exact))
     assert gaps[0] > 3.0 * gaps[1] > 9.0 * gaps[2] > 0.0
     assert gaps[2] < 1e-6 * abs(exact)

@@ -6,7 +6,8 @@ from scipy.optimize import brentq
 
 import beltsim
 from beltsim.physics.friction import law_numpy
-from beltsim.physics.model import Loads, State, forces_numpy
+from beltsim.physics import reference
+from beltsim.physics.model import Loads, State
 from beltsim.problem.drive import mismatch
 from beltsim.problem.scene import Scene
 from beltsim.simulation.controller import Simulation
@@ -205,31 +206,26 @@ def _explicit_step_numpy(d, u, th, va, wa, db, t, dt):
     Returns u, theta, the velocities after the kick, its bottom increments, the
     friction and the rates at t + dt."""
     P, p, mesh = d.params, d.model, d.mesh
-    c, hh, dmp = P.c, 0.5 * P.h, p.damping
-    he, hb, j2 = mesh.he, mesh.hb, mesh.j2
+    c, hh = P.c, 0.5 * P.h
+    hb, j2 = mesh.hb, mesh.j2
     n = len(u)
     inner = np.arange(1, n - 1)
+    ops = reference.operators(mesh, p)  # the model's gyroscopic and damping terms: C
 
-    def velocity_terms(v, mass):  # upwind gyroscopic and damping forces of velocities v
-        f = np.zeros(n)
-        f[inner] = (2.0 * mass * c * hb[inner] * (v[inner] - v[inner - 1]) / he[inner - 1]
-                    + dmp * mass * hb[inner] * v[inner])
-        return f
-
-    def trapezoid(v, mass):  # m (vb - va) / dt + f((va + vb) / 2) = 0, f linear
-        A = np.array([velocity_terms(e, mass)[inner] for e in np.eye(n)]).T[:, inner]
-        m = mass * hb[inner]
-        lhs = np.diag(m / dt) + 0.5 * A
-        rhs = m / dt * v[inner] - 0.5 * A @ v[inner]
+    def trapezoid(v, field):  # M (vb - va) / dt + C (va + vb) / 2 = 0, for one field
+        C = ops.damping[field::2, field::2].toarray()  # the fields do not couple in C
+        m = ops.mass[field::2]
         out = np.zeros(n)
-        out[inner] = np.linalg.solve(lhs, rhs)
+        out[inner] = np.linalg.solve(np.diag(m / dt) + 0.5 * C,
+                                     m / dt * v[inner] - 0.5 * C @ v[inner])
         return out
 
-    vb, wb = trapezoid(va, P.rho), trapezoid(wa, P.I)
+    vb, wb = trapezoid(va, 0), trapezoid(wa, 1)
     u1, th1 = u + 0.5 * dt * (va + vb), th + 0.5 * dt * (wa + wb)
     t1 = t + dt
-    fu, ft, _ = forces_numpy(u1, th1, 0 * u, 0 * u, t1, mesh, p._replace(friction_scale=0.0),
-                             d.drive, d.loads)
+    f, _ = reference.forces(u1, th1, 0 * u, 0 * u, t1, mesh, p._replace(friction_scale=0.0),
+                            d.drive, d.loads)
+    fu, ft = f[:, 0], f[:, 1]
     m, mi = P.rho * hb, P.I * hb
     eu, et = np.zeros(n), np.zeros(n)
     eu[inner], et[inner] = dt * fu / m[inner], dt * ft / mi[inner]
@@ -242,7 +238,7 @@ def _explicit_step_numpy(d, u, th, va, wa, db, t, dt):
         kb = dt * (1 / m[j] + hh * hh / mi[j])
 
         def force(vhat, j=j):
-            return -wf[j] * p.friction_scale * law_numpy(p.law, vhat / p.v_reg)[0]
+            return -wf[j] * p.friction_scale * law_numpy(p.law, vhat / p.regularisation)[0]
 
         def slip(vhat, j=j, kb=kb):  # the slip velocity's estimate, given the force
             dj = delta[j] + kb * force(vhat)

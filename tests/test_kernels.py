@@ -1,9 +1,12 @@
-"""numba kernels against their numpy twins and independent checks."""
+"""numba kernels against the vectorised reference (physics.reference) and independent checks."""
 
 import numpy as np
 import pytest
 
+from beltsim.physics import reference
 from beltsim.physics.friction import (
+    ADHESION,
+    EXACT,
     LAW_CODES,
     LINEAR,
     RAMP,
@@ -15,16 +18,19 @@ from beltsim.physics.friction import (
 )
 from beltsim.physics.grid import bisect, make_grid
 from beltsim.physics.model import (
+    POWER_TERMS,
     Loads,
     State,
+    add_stick_penalty,
     assemble,
     blocks_to_dense,
     hermite_weights,
     load_at,
-    residual_numpy,
+    power_terms,
+    rate_part,
     update_multipliers,
 )
-from beltsim.problem.drive import ramp
+from beltsim.problem.drive import friction_factor, ramp
 from beltsim.problem.scene import Scene
 from beltsim.solvers import Discretisation
 from beltsim.solvers.newton import (
@@ -72,21 +78,53 @@ def _random_loads(n, seed):
                  *(1e3 * rng.standard_normal((3, n)) for _ in range(4)))
 
 
-@pytest.mark.parametrize("law_name", ["tanh", "sqrt", "ramp"])
-@pytest.mark.parametrize("inertia", [True, False])
-def test_residual_matches_numpy_twin(law_name, inertia):
-    d, grid, p = _setup([f"numerics.friction_law={law_name}",
-                         f"physics.inertia={str(inertia).lower()}"])
-    u, th, old = _random_state(grid, 1)
-    lam = np.zeros_like(u)
-    w, fnode = _assemble(d, u, th, lam, old, 1e4, 0.005, p)
-    R, F = residual_numpy(u, th, old, 1e4, 0.005, d.mesh, p, d.drive)
-    np.testing.assert_allclose(w.R, R, rtol=1e-12, atol=1e-9 * np.abs(R).max())
-    np.testing.assert_allclose(fnode, F, rtol=1e-12, atol=1e-12)
-    loads = _random_loads(len(u), 7)
-    w, _ = _assemble(d, u, th, lam, old, 1e4, 0.005, p, loads)
-    R, _ = residual_numpy(u, th, old, 1e4, 0.005, d.mesh, p, d.drive, loads)
-    np.testing.assert_allclose(w.R, R, rtol=1e-12, atol=1e-9 * np.abs(R).max())
+# Every law in its primal form (the kernels' primal-dual form is checked against it
+# below); the regularisation is set so that the random slip velocities (~5 m/s) fall on
+# the steep part of the saturating laws and the exact law's stick test goes both ways.
+LAWS = {"linear": LINEAR, "tanh": TANH, "sqrt": SQRT, "ramp": RAMP, "exact": EXACT,
+        "adhesion": ADHESION}
+
+
+def _kernel_and_reference(code, inertia, inv_dt, loads, seed=1):
+    """(kernel, reference, k) at a random state: residual, nodal friction and dense
+    Jacobian of each, and the reference's friction stiffnesses."""
+    d, grid, p = _setup([f"physics.inertia={str(inertia).lower()}"])
+    p = p._replace(law=code, regularisation=5.0)
+    u, th, old = _random_state(grid, seed, amp=1e-4)
+    rng = np.random.default_rng(seed + 100)
+    lam = 1.5 * rng.uniform(-1.0, 1.0, len(u))  # the exact laws' multipliers: stick and slip
+    t = 0.005
+    ld = _random_loads(len(u), seed + 7) if loads else Loads.none(len(u))
+    w, fnode = _assemble(d, u, th, lam, old, inv_dt, t, p, ld)
+    ratios = None
+    if code >= EXACT:
+        add_stick_penalty(w, inv_dt, p.friction_scale * friction_factor(d.drive, t), d.mesh, p)
+        ratios = lam
+    R, F = reference.residual(u, th, old, inv_dt, t, d.mesh, p, d.drive, ld, ratios)
+    J = reference.jacobian(u, th, old, inv_dt, t, d.mesh, p, d.drive, ratios).toarray()
+    vrel = reference.slip_velocity(u, th, (u - old.u) * inv_dt, (th - old.theta) * inv_dt, t,
+                                   d.mesh, p, d.drive)
+    k = reference.friction(vrel, t, d.mesh, p, d.drive, ratios)[1]
+    return (w.R, fnode, blocks_to_dense(w.Lb, w.Db, w.Ub, w.L2)), (R, F, J), k
+
+
+@pytest.mark.parametrize("law_name", list(LAWS))
+@pytest.mark.parametrize("inv_dt", [0.0, 3e3])
+@pytest.mark.parametrize("inertia, loads", [(True, True), (True, False), (False, True)])
+def test_residual_and_jacobian_match_the_reference(law_name, inv_dt, inertia, loads):
+    """assemble (primal form; exact laws with their stick penalty) is the reference's
+    residual and sparse Jacobian: the same sums in another order, so they agree to
+    round-off, ~1e-16 of the largest term of a row (1e-12 leaves room for the
+    cancellation of terms up to 1e4 times the row's result)."""
+    (Rk, Fk, Jk), (R, F, J), k = _kernel_and_reference(LAWS[law_name], inertia, inv_dt, loads)
+    np.testing.assert_allclose(Rk, R, rtol=0, atol=1e-12 * np.abs(R).max())
+    np.testing.assert_allclose(Fk, F, rtol=0, atol=1e-13 * np.abs(F).max())
+    scale = np.abs(J).max(axis=1, keepdims=True)  # rows in units of their largest entry
+    np.testing.assert_allclose(Jk / scale, J / scale, rtol=0, atol=1e-12)
+    # the friction's slopes are exercised: contact nodes away from saturation (for the
+    # exact law, stuck and sliding ones side by side)
+    assert np.count_nonzero(k > 0.1 * k.max()) >= 5
+    assert law_name != "exact" or np.count_nonzero(k == 0.0) >= 3
 
 
 def test_hermite_loads_interpolate_cubics_exactly():
@@ -118,19 +156,24 @@ def test_dual_residual_equals_primal_when_multiplier_consistent(law_name):
                                atol=1e-7 * np.abs(wp.R).max())
 
 
-@pytest.mark.parametrize("law_name", ["tanh", "sqrt", "ramp"])
+@pytest.mark.parametrize("law_name", ["linear", "tanh", "sqrt", "ramp"])
 @pytest.mark.parametrize("inv_dt", [0.0, 3e3])
-def test_jacobian_matches_finite_differences(law_name, inv_dt):
-    d, grid, p = _setup([f"numerics.friction_law={law_name}", "numerics.regularisation=0.05"])
+def test_reference_jacobian_is_the_derivative_of_its_residual(law_name, inv_dt):
+    """The reference's sparse Jacobian against central differences of its residual (which
+    the kernels match, test above), at a state whose slip velocities lie on the steep
+    part of the law (v_reg 5 m/s against ~5 m/s)."""
+    d, grid, p = _setup()
+    p = p._replace(law=LAWS[law_name], regularisation=5.0)
     u, th, old = _random_state(grid, 3, amp=1e-4)
-    lam = np.zeros_like(u)
-    w, _ = _assemble(d, u, th, lam, old, inv_dt, 1.0, p)
-    J = blocks_to_dense(w.Lb, w.Db, w.Ub, w.L2)
+    loads = _random_loads(len(u), 3)
+    J = reference.jacobian(u, th, old, inv_dt, 0.005, d.mesh, p, d.drive).toarray()
     n = grid.n_elements - 1
     Jfd = np.zeros_like(J)
     y = np.column_stack([u[1:-1], th[1:-1]]).ravel()
     for k in range(2 * n):
-        # central differences: truncation O(step^2 g''') is far below the 1e-5 tolerance
+        # step 1e-9 against values ~1e-4: the truncation, O(step^2) of the law's third
+        # derivative over the slip velocity's scale, and the round-off of R / step are
+        # both below 1e-7 of a row's largest entry
         step = 1e-9
         res = []
         for sgn in (1, -1):
@@ -138,10 +181,45 @@ def test_jacobian_matches_finite_differences(law_name, inv_dt):
             yy[k] += sgn * step
             uu, tt = u.copy(), th.copy()
             uu[1:-1], tt[1:-1] = yy[0::2], yy[1::2]
-            res.append(residual_numpy(uu, tt, old, inv_dt, 1.0, d.mesh, p, d.drive)[0].ravel())
+            res.append(reference.residual(uu, tt, old, inv_dt, 0.005, d.mesh, p, d.drive,
+                                          loads)[0].ravel())
         Jfd[:, k] = (res[0] - res[1]) / (2 * step)
     scale = np.abs(J).max(axis=1, keepdims=True)
-    np.testing.assert_allclose(J / scale, Jfd / scale, atol=1e-5)
+    np.testing.assert_allclose(J / scale, Jfd / scale, rtol=0, atol=1e-6)
+
+
+def test_rate_part_is_the_references_time_derivative_part():
+    """The implicit scheme's error filter applies T = a0^2 M + a0 C (the Jacobian's terms
+    in inv_dt = a0, friction at given slopes): the kernel rate_part against the
+    reference's operators, with a load and friction nodes of all slopes."""
+    d, grid, p = _setup()
+    n = grid.n_elements - 1
+    rng = np.random.default_rng(11)
+    e = rng.standard_normal((n, 2))
+    sg = rng.uniform(0.0, 1.0, len(grid.x))
+    a0, fs = 2.7e3, 0.8 * p.friction_scale
+    out = np.empty_like(e)
+    rate_part(e, a0, fs, sg, d.mesh, p, out)
+    ops = reference.operators(d.mesh, p)
+    j = reference.contact_nodes(d.mesh)
+    k = d.mesh.wf[j] * fs * sg[j] / p.regularisation
+    _, Cf = reference.friction_matrices(k, reference.friction_pattern(d.mesh, p), n)
+    want = a0 * a0 * ops.mass * e.ravel() + a0 * ((ops.damping + Cf) @ e.ravel())
+    np.testing.assert_allclose(out.ravel(), want, rtol=1e-13, atol=1e-13 * np.abs(want).max())
+
+
+def test_power_terms_match_the_reference():
+    d, grid, p = _setup()
+    rng = np.random.default_rng(12)
+    n_nodes = len(grid.x)
+    state = State(*(1e-3 * rng.standard_normal(n_nodes) for _ in State._fields))
+    for a in state:
+        a[[0, -1]] = 0.0
+    loads = _random_loads(n_nodes, 12)
+    out = np.zeros(len(POWER_TERMS))
+    power_terms(state, 0.005, d.mesh, p, d.drive, loads, out)
+    want = reference.power_terms(state, 0.005, d.mesh, p, d.drive, loads)
+    np.testing.assert_allclose(out, want, rtol=1e-12)
 
 
 def test_block_factor_matches_dense_on_a_tridiagonal_system():
@@ -213,8 +291,8 @@ def test_dual_newton_solution_satisfies_primal_equations():
     ok = newton(state, rest, 1.0 / 2e-3, 1.0, d.mesh, p, d.drive, d.loads, d.scales,
                 NewtonSettings(1e-11, 60), w)
     assert ok
-    R, F = residual_numpy(state.u, state.theta, rest, 1.0 / 2e-3, 1.0, d.mesh,
-                          p._replace(dual=0), d.drive)
+    R, F = reference.residual(state.u, state.theta, rest, 1.0 / 2e-3, 1.0, d.mesh,
+                              p._replace(dual=0), d.drive)
     # forces per node are O(f* h) ~ 1e2 N; round-off of the 1e-11 Newton tolerance
     assert np.abs(R[:, 0]).max() < 1e-6 * d.scales.force
     np.testing.assert_allclose(state.fnode, F, atol=1e-9 * d.params.fstar * grid.he.max())

@@ -3,7 +3,7 @@
 A smooth nodal history u_j(t) = X_j phi(t), theta_j(t) = Y_j phi(t) is made the exact
 solution of the semi-discrete model by the distributed loads it leaves unbalanced,
 q = (M u_tt - forces(u, u_t, t)) / hbar, computed with the numpy twin of the model
-(physics.model.forces_numpy) and tabulated densely in time (cubic Hermite, error
+(physics.reference.forces) and tabulated densely in time (cubic Hermite, error
 O(dt_table^4), far below the schemes' errors). The space discretisation then makes no
 error at all, so what remains is the time integrator's: its order is measured at
 fixed steps dt, dt/2, dt/4. phi(t) = (1 - cos w t)^2 starts at rest with zero
@@ -16,7 +16,8 @@ import pytest
 
 import beltsim
 from beltsim.physics.friction import law_numpy
-from beltsim.physics.model import Loads, forces_numpy
+from beltsim.physics import reference
+from beltsim.physics.model import Loads
 from beltsim.problem.drive import friction_factor, mismatch
 from helpers import scene_path
 
@@ -56,11 +57,11 @@ def _manufactured(sim):
         p, dp, ddp = _phi(t)
         u, th = shape_u * p, shape_t * p
         ud, td = shape_u * dp, shape_t * dp
-        fu, ft, _ = forces_numpy(u, th, ud, td, t, d.mesh, d.model, d.drive)
+        f, _ = reference.forces(u, th, ud, td, t, d.mesh, d.model, d.drive)
         hb = d.mesh.hb[1:-1]
         qu, qt = np.zeros_like(x), np.zeros_like(x)
-        qu[1:-1] = (d.params.rho * hb * shape_u[1:-1] * ddp - fu) / hb
-        qt[1:-1] = (d.params.I * hb * shape_t[1:-1] * ddp - ft) / hb
+        qu[1:-1] = (d.params.rho * hb * shape_u[1:-1] * ddp - f[:, 0]) / hb
+        qt[1:-1] = (d.params.I * hb * shape_t[1:-1] * ddp - f[:, 1]) / hb
         return qu, qt
 
     q = [loads_at(t) for t in times]
@@ -144,11 +145,11 @@ def _continuous_loads(sim, gyro="exact"):
         ph, dph, ddph = _phi(t)
         vrel = (u0 + hh * t0) * dph + c * (u1 + hh * t1) * ph - mismatch(d.drive, t)
         f = contact * -p.friction_scale * friction_factor(d.drive, t) * law_numpy(
-            p.law, vrel / p.v_reg)[0]
+            p.law, vrel / p.regularisation)[0]
         qu = (p.mass * (u0 * ddph + 2 * c * gu * dph + p.damping * u0 * dph)
-              - p.tension_eff * u2 * ph - f)
+              - p.B * u2 * ph - f)
         qt = (p.rotary_inertia * (t0 * ddph + 2 * c * gt * dph + p.damping * t0 * dph)
-              - p.bending_eff * t2 * ph + p.shear * t0 * ph - hh * f)
+              - p.A * t2 * ph + p.shear * t0 * ph - hh * f)
         return qu, qt
 
     times = np.linspace(0.0, SPAN, TABLE)

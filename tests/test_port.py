@@ -8,6 +8,7 @@ same equations with array operations and a general sparse LU.
 import numpy as np
 import pytest
 
+from beltsim.physics.model import Loads
 from beltsim.problem.scene import load_scene
 from beltsim.simulation.controller import Simulation
 from benchmarks import port
@@ -45,6 +46,26 @@ def test_banded_port_takes_the_same_steps():
     assert theirs.statistics["steps"] == ours.statistics["steps"]
     a, b = ours.solution.total_friction, theirs.solution.total_friction
     assert abs(a - b) <= 1e-8 * abs(a)
+
+
+def test_port_takes_the_same_steps_under_distributed_loads():
+    scene = load_scene(scene_path("paper_slip"), ["numerics.elements=40", "numerics.t_end=0.03"])
+    ours, theirs = Simulation(scene), port.port_simulation(scene)
+    x = ours.grid.x
+    shape = np.sin(np.pi * x / x[-1])
+    # a load growing over the run: 2 kN/m on u and 20 N m/m on theta at the end
+    qu, qt = np.outer([0.0, 2e3], shape), np.outer([0.0, 20.0], shape)
+    loads = Loads(np.array([0.0, 0.03]), qu, qt, np.zeros_like(qu), np.zeros_like(qt))
+    for sim in (ours, theirs):
+        sim.disc.loads = loads
+    a, b = ours.run(), theirs.run()
+    np.testing.assert_array_equal(a.history["t"], b.history["t"])
+    assert a.statistics["steps"] == b.statistics["steps"]
+    assert a.power_balance["load_work"] != 0.0
+    for key in ("load_work", "stored_energy_change"):
+        assert b.power_balance[key] == pytest.approx(a.power_balance[key], rel=1e-8), key
+    np.testing.assert_allclose(b.solution.u, a.solution.u, rtol=0,
+                               atol=1e-8 * np.abs(a.solution.u).max())
 
 
 def test_port_refuses_what_it_does_not_implement():

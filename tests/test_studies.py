@@ -73,22 +73,28 @@ def test_peer_rhs_is_the_semi_discrete_model():
     sim = Simulation(load_scene(scene_path("paper_slip"), ["numerics.elements=40"]))
     peer = peers.PeerSystem(sim)
     rng = np.random.default_rng(0)
-    y = 1e-4 * rng.standard_normal(4 * peer.n)
-    f = peer.rhs(0.3, y)
     n = peer.n
-    from beltsim.physics.model import State, residual_numpy
+    y = 1e-4 * rng.standard_normal(4 * n)
+    f = peer.rhs(0.3, y)
+    from beltsim.physics.model import State
+    from beltsim.physics.reference import residual
     dt = 1e-3
-    u, th, ud, td = (np.concatenate([[0], part, [0]]) for part in np.split(y, 4))
-    acc_u = np.concatenate([[0], f[2 * n:3 * n], [0]])
-    acc_t = np.concatenate([[0], f[3 * n:], [0]])
+
+    def nodal(part):  # y's (u, theta) pairs of the interior nodes as nodal arrays
+        return [np.concatenate([[0], part[k::2], [0]]) for k in (0, 1)]
+
+    u, th = nodal(y[:2 * n])
+    ud, td = nodal(y[2 * n:])
+    acc_u, acc_t = nodal(f[2 * n:])
     # choose the "old" state so that the backward-Euler velocities are ud, td and the
     # accelerations are the peer's
     zero = np.zeros_like(u)
     old = State(u - dt * ud, th - dt * td, zero, ud - dt * acc_u, td - dt * acc_t, zero)
     d = sim.disc
-    R, _ = residual_numpy(u, th, old, 1 / dt, 0.3, d.mesh, d.model, d.drive)
+    R, _ = residual(u, th, old, 1 / dt, 0.3, d.mesh, d.model, d.drive)
     scale = sim.params.B * d.scales.theta
     assert np.abs(R).max() < 1e-9 * scale
+    np.testing.assert_array_equal(f[:2 * n], y[2 * n:])  # the drift q' = q'
 
 
 @pytest.mark.cli

@@ -48,7 +48,6 @@ from .friction import (
     has_dual,
     law,
     law_inverse,
-    law_numpy,
 )
 
 # |lam| bound in the primal-dual iteration: the friction of a fully sliding node is
@@ -59,8 +58,8 @@ LAM_MAX = 1.0 - 1e-14
 class ModelParams(NamedTuple):
     """The coefficients of the discrete model, as the kernels read them."""
 
-    tension_eff: float  # B = b1 - rho c^2
-    bending_eff: float  # A = a - I c^2
+    B: float  # effective tension stiffness b1 - rho c^2
+    A: float  # effective bending stiffness a - I c^2
     shear: float  # b2
     mass: float  # rho, per unit length (0 when quasistatic)
     rotary_inertia: float  # I, per unit length (0 when quasistatic)
@@ -68,7 +67,7 @@ class ModelParams(NamedTuple):
     half_height: float  # h / 2: lever of the friction about the middle line
     damping: float  # d (1/s) of d rho u_t and d I theta_t
     friction_scale: float  # f_s in f = -f_s g(v_rel / v_reg)
-    v_reg: float  # regularisation velocity
+    regularisation: float  # the law's velocity scale: v_reg; v_aug for the exact laws
     law: int  # friction law code (friction.LAW_CODES)
     dual: int  # 1: the friction ratio is a Newton unknown (primal-dual form)
 
@@ -78,7 +77,7 @@ class Mesh(NamedTuple):
 
     Friction acts at the contact nodes c0..j2: node j carries the nodal force
     F_j = -wf_j f_s lam_j, lam_j the friction ratio of its slip velocity
-    v_rel,j = d/dt u_b,j + c sum_o sw[j, o] u_b,{j-2+o} - (v - c) (offsets -2..+1).
+    v_rel,j = d/dt u_b,j + c sum_o sw[j, o] u_b,{j-2+o} - (v - c) (offsets -2..0).
     """
 
     he: np.ndarray  # element lengths (N)
@@ -87,7 +86,7 @@ class Mesh(NamedTuple):
     j2: int  # node at x2
     c0: int  # first friction node
     wf: np.ndarray  # friction weight (m) of each node (N + 1), 0 off the friction nodes
-    sw: np.ndarray  # d/dx u_b at node j: weights of u_b at j-2, j-1, j, j+1 (N + 1, 4)
+    sw: np.ndarray  # d/dx u_b at node j: weights of u_b at j-2, j-1, j (N + 1, 3)
 
 
 class State(NamedTuple):
@@ -169,14 +168,14 @@ def load_at(q, dq, k, w0, w1, v0, v1, j):
     return w0 * q[k, j] + w1 * q[k + 1, j] + v0 * dq[k, j] + v1 * dq[k + 1, j]
 
 
-def model_params(P, damping, friction_scale, v_reg, law_code) -> ModelParams:
+def model_params(P, damping, friction_scale, regularisation, law_code) -> ModelParams:
     """The model's coefficients from the physical parameters and the friction settings."""
     # the linear law's dual and primal forms coincide; saturating laws need the dual
     dual = int(has_dual(law_code) and law_code != LINEAR)
     return ModelParams(
-        tension_eff=P.B, bending_eff=P.A, shear=P.b2, mass=P.rho, rotary_inertia=P.I,
+        B=P.B, A=P.A, shear=P.b2, mass=P.rho, rotary_inertia=P.I,
         speed=P.c, half_height=0.5 * P.h, damping=damping, friction_scale=friction_scale,
-        v_reg=v_reg, law=law_code, dual=dual)
+        regularisation=regularisation, law=law_code, dual=dual)
 
 
 def regularised(p: ModelParams) -> ModelParams:
@@ -184,63 +183,37 @@ def regularised(p: ModelParams) -> ModelParams:
     default v_reg = v_aug / AUGMENTATION for Coulomb, the linear law of the default
     adhesion layer (slope f_s / v_aug) for adhesion."""
     if p.law == EXACT:
-        return p._replace(law=TANH, dual=1, v_reg=p.v_reg / AUGMENTATION)
+        return p._replace(law=TANH, dual=1, regularisation=p.regularisation / AUGMENTATION)
     if p.law == ADHESION:
         return p._replace(law=LINEAR, dual=0)
     return p
 
 
-# How the transport c d/dx u_b of the slip velocity is discretised (contact_stencil).
-TRANSPORT = "bdf2"
-TRANSPORTS = ("upwind", "bdf2", "central", "nodal1")
-
-
-def contact_stencil(x, j1, j2, kind=None):
+def contact_stencil(x, j1, j2):
     """(c0, wf, sw) of the contact [x_j1, x_j2] on the nodes x (see :class:`Mesh`).
 
-    * "upwind" (first order): the slip velocity of element [x_{j-1}, x_j] with its
-      strain, lumped on node j (c0 = j1 + 1, wf_j = h_{j-1});
-    * "bdf2" (second order): the slip velocity at node j with the one-sided
-      three-point derivative over x_{j-2}, x_{j-1}, x_j (exact for quadratics on any
-      grid), its friction on the contact part of node j's control volume (c0 = j1,
-      half volumes at x1 and x2: trapezoidal quadrature). On a uniform grid the
-      homogeneous solutions of the 3-point upwind difference are 1 and 3^-k (k nodes
-      downstream): no odd-even mode;
-    * "nodal1" (measured, first order): the two-point backward difference at node j
-      with the trapezoidal weights of "bdf2";
-    * "central" (for the oscillation test): (u_b,{j+1} - u_b,{j-1}) / (x_{j+1} -
-      x_{j-1}) with trapezoidal weights; decouples odd and even nodes.
+    The slip velocity at node j with the one-sided three-point derivative over x_{j-2},
+    x_{j-1}, x_j (second order, exact for quadratics on any grid), its friction on the
+    contact part of node j's control volume (c0 = j1, half volumes at x1 and x2:
+    trapezoidal quadrature). On a uniform grid the homogeneous solutions of the
+    three-point upwind difference are 1 and 3^-k (k nodes downstream): no odd-even mode.
     """
-    kind = TRANSPORT if kind is None else kind
     x = np.asarray(x, dtype=float)
     N = len(x) - 1
     he = np.diff(x)
     wf = np.zeros(N + 1)
-    sw = np.zeros((N + 1, 4))
-    if kind == "upwind":
-        j = np.arange(j1 + 1, j2 + 1)
-        wf[j] = he[j - 1]
-        sw[j, 1], sw[j, 2] = -1.0 / he[j - 1], 1.0 / he[j - 1]
-        return j1 + 1, wf, sw
-    if kind not in TRANSPORTS:
-        raise ValueError(f"unknown transport discretisation {kind!r}")
+    sw = np.zeros((N + 1, 3))
     j = np.arange(j1, j2 + 1)
     wf[j] = 0.5 * (np.where(j > j1, he[j - 1], 0.0) + np.where(j < j2, he[j], 0.0))
     h1, h2 = he[j - 1], he[j - 2]
-    if kind == "bdf2":
-        sw[j, 0] = h1 / (h2 * (h1 + h2))
-        sw[j, 1] = -(h1 + h2) / (h1 * h2)
-        sw[j, 2] = (2.0 * h1 + h2) / (h1 * (h1 + h2))
-    elif kind == "nodal1":
-        sw[j, 1], sw[j, 2] = -1.0 / h1, 1.0 / h1
-    else:
-        d = h1 + he[j]
-        sw[j, 1], sw[j, 3] = -1.0 / d, 1.0 / d
+    sw[j, 0] = h1 / (h2 * (h1 + h2))
+    sw[j, 1] = -(h1 + h2) / (h1 * h2)
+    sw[j, 2] = (2.0 * h1 + h2) / (h1 * (h1 + h2))
     return j1, wf, sw
 
 
-def mesh_of(grid, kind=None) -> Mesh:
-    c0, wf, sw = contact_stencil(grid.x, grid.j1, grid.j2, kind)
+def mesh_of(grid) -> Mesh:
+    c0, wf, sw = contact_stencil(grid.x, grid.j1, grid.j2)
     return Mesh(grid.he, grid.hbar, grid.j1, grid.j2, c0, wf, sw)
 
 
@@ -248,11 +221,43 @@ def mesh_of(grid, kind=None) -> Mesh:
 def bottom_strain(u, th, hh, sw, j):
     """d/dx u_b at friction node j from the stencil weights sw[j]."""
     e = 0.0
-    for o in range(4):
+    for o in range(3):
         k = j - 2 + o
         if sw[j, o] != 0.0:
             e += sw[j, o] * (u[k] + hh * th[k])
     return e
+
+
+@njit(cache=True, inline="always")
+def rate_blocks(hbj, hl, inv_dt, p):
+    """The terms in inv_dt of interior row j's Jacobian (its time-derivative part), but
+    for friction: the lumped inertia and damping m_j (inv_dt^2 + d inv_dt) and the
+    upwind gyroscopic term m_j (2 c / h_{j-1}) inv_dt (v_j - v_{j-1}), m_j = rho hbar_j
+    in the u row and I hbar_j in the theta row. Returns the (diagonal, lower) entries of
+    the u row and of the theta row."""
+    kin = inv_dt * inv_dt + p.damping * inv_dt  # d(acc + damp * vel)/dy
+    gyro = 2.0 * p.speed * hbj / hl
+    rho, I = p.mass, p.rotary_inertia
+    return (rho * hbj * kin + rho * gyro * inv_dt, -rho * gyro * inv_dt,
+            I * hbj * kin + I * gyro * inv_dt, -I * gyro * inv_dt)
+
+
+@njit(cache=True, inline="always")
+def own_rate_slope(o, inv_dt):
+    """d v_rel,j / d u_b at node j - 2 + o through the rate d/dt u_b,j: inv_dt at j itself."""
+    return inv_dt if o == 2 else 0.0
+
+
+@njit(cache=True, inline="always")
+def slip_velocity_slope(sw, j, o, c, inv_dt):
+    """d v_rel,j / d u_b at node j - 2 + o (o = 0..2): transport, and the rate at j."""
+    return c * sw[j, o] + own_rate_slope(o, inv_dt)
+
+
+@njit(cache=True, inline="always")
+def friction_stiffness(wfj, fs, sgj, p):
+    """k = -dF_j/dv_rel of node j: weight wf_j, friction scale fs, slope sg_j of the ratio."""
+    return wfj * fs * sgj / p.regularisation
 
 
 @njit(cache=True)
@@ -270,16 +275,18 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
     block band (two lower block bands from the friction stencil, one upper). w.sg
     receives the slope dlam/d(v_rel / v_reg) used by :func:`update_multipliers`.
 
-    The exact laws (friction.EXACT, ADHESION; p.v_reg is then the augmentation
-    velocity v_aug) keep lam as a full unknown of a semi-smooth Newton iteration
-    (:mod:`beltsim.solvers.ssn`): its force enters as it is, with no Jacobian entry
-    here; rl receives v_rel / v_aug and sg 1 where lam + rl projects inside [-1, 1]
-    (stick) and 0 where it slides.
+    The exact laws (friction.EXACT, ADHESION; p.regularisation is then the
+    augmentation velocity v_aug) keep lam as a full unknown of a semi-smooth Newton
+    iteration (:mod:`beltsim.solvers.ssn`): its force enters as it is, with no Jacobian
+    entry here; rl receives v_rel / v_aug and sg 1 where lam + rl projects inside
+    [-1, 1] (stick) and 0 where it slides.
+
+    :mod:`beltsim.physics.reference` writes the same equations with numpy.
     """
     N = u.shape[0] - 1
-    B, A, b2 = p.tension_eff, p.bending_eff, p.shear
+    B, A, b2 = p.B, p.A, p.shear
     rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
-    damp, vreg = p.damping, p.v_reg
+    damp = p.damping
     fs = p.friction_scale * friction_factor(drive, t)
     he, hb, j2 = mesh.he, mesh.hb, mesh.j2
     c0, wf, sw = mesh.c0, mesh.wf, mesh.sw
@@ -289,7 +296,6 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
     target = mismatch(drive, t)
     lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
     code, dual = p.law, p.dual
-    kin = inv_dt * inv_dt + damp * inv_dt  # d(acc + damp * vel)/dy
     for j in range(N + 1):
         fnode[j] = 0.0
     for j in range(1, N):
@@ -319,12 +325,12 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
                         L2[i, a_, b_] = 0.0
                         Db[i, a_, b_] = 0.0
                         Ub[i, a_, b_] = 0.0
-            Db[i, 0, 0] = rho * hbj * kin + rho * gyro * inv_dt + B * (1.0 / hl + 1.0 / hr)
-            Lb[i, 0, 0] = -rho * gyro * inv_dt - B / hl
+            du, lu, dt_, lt = rate_blocks(hbj, hl, inv_dt, p)
+            Db[i, 0, 0] = du + B * (1.0 / hl + 1.0 / hr)
+            Lb[i, 0, 0] = lu - B / hl
             Ub[i, 0, 0] = -B / hr
-            Db[i, 1, 1] = (I * hbj * kin + I * gyro * inv_dt + A * (1.0 / hl + 1.0 / hr)
-                           + b2 * hbj)
-            Lb[i, 1, 1] = -I * gyro * inv_dt - A / hl
+            Db[i, 1, 1] = dt_ + A * (1.0 / hl + 1.0 / hr) + b2 * hbj
+            Lb[i, 1, 1] = lt - A / hl
             Ub[i, 1, 1] = -A / hr
         if j >= c0 and j <= j2:
             # slip velocity at node j (stencil sw[j]), friction on its weight wf[j]
@@ -334,7 +340,7 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
             if code >= EXACT:
                 # lam is the semi-smooth Newton's own unknown (solvers.ssn): its force
                 # enters as it is; rl: v_rel / v_aug; sg: 1 where proj(lam + rl) sticks
-                rl[j] = vrel / vreg
+                rl[j] = vrel / p.regularisation
                 z = lam[j] + rl[j]
                 sg[j] = 0.0 if code == EXACT and abs(z) >= 1.0 else 1.0
                 fnode[j] = -wf[j] * fs * lam[j]
@@ -345,19 +351,40 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
                 continue
             if dual:
                 gi, dgi = law_inverse(code, lam[j])
-                rl[j] = vrel / vreg - gi
+                rl[j] = vrel / p.regularisation - gi
                 sg[j] = 1.0 / dgi
             else:
-                lam[j], sg[j] = law(code, vrel / vreg)
+                lam[j], sg[j] = law(code, vrel / p.regularisation)
                 rl[j] = 0.0
             wj = wf[j]
             fnode[j] = -wj * fs * lam[j]
             ru += wj * fs * (lam[j] + sg[j] * rl[j])
             rt += hh * wj * fs * (lam[j] + sg[j] * rl[j])
             if want_jac:
-                add_friction_slope(w, i, j, wj * fs * sg[j] / vreg, inv_dt, c, hh, sw)
+                add_friction_slope(w, i, j, friction_stiffness(wj, fs, sg[j], p), inv_dt, c,
+                                   hh, sw)
         R[i, 0] = ru
         R[i, 1] = rt
+
+
+@njit(cache=True)
+def rate_part(e, a0, fs, sg, mesh, p, out):
+    """out = T e (both (n, 2)): T the time-derivative part of assemble's Jacobian at
+    inv_dt = a0, the terms in a0 (rate_blocks, and friction through the node's own
+    rate) with the friction slopes sg (N + 1) and the friction scale fs."""
+    he, hb, hh = mesh.he, mesh.hb, p.half_height
+    for i in range(e.shape[0]):
+        j = i + 1
+        du, lu, dt_, lt = rate_blocks(hb[j], he[j - 1], a0, p)
+        ul = e[i - 1, 0] if i > 0 else 0.0
+        tl = e[i - 1, 1] if i > 0 else 0.0
+        out[i, 0] = du * e[i, 0] + lu * ul
+        out[i, 1] = dt_ * e[i, 1] + lt * tl
+        if mesh.c0 <= j <= mesh.j2:
+            k = friction_stiffness(mesh.wf[j], fs, sg[j], p) * own_rate_slope(2, a0)
+            eb = e[i, 0] + hh * e[i, 1]
+            out[i, 0] += k * eb
+            out[i, 1] += hh * k * eb
 
 
 @njit(cache=True)
@@ -368,36 +395,29 @@ def add_stick_penalty(w, inv_dt, fs, mesh, p):
     what needs a 2x2 Jacobian: the implicit scheme's error filter, the linearisation."""
     for j in range(mesh.c0, mesh.j2 + 1):
         w.sg[j] *= AUGMENTATION
-        add_friction_slope(w, j - 1, j, mesh.wf[j] * fs * w.sg[j] / p.v_reg, inv_dt,
-                           p.speed, p.half_height, mesh.sw)
+        add_friction_slope(w, j - 1, j, friction_stiffness(mesh.wf[j], fs, w.sg[j], p),
+                           inv_dt, p.speed, p.half_height, mesh.sw)
 
 
-@njit(cache=True, inline="always")
-def slip_velocity_slope(sw, j, o, c, inv_dt):
-    """d v_rel,j / d u_b at node j - 2 + o (o = 0..3): transport, and inv_dt at j itself."""
-    return c * sw[j, o] + (inv_dt if o == 2 else 0.0)
-
-
-@njit(cache=True, inline="always")
-def stencil_band(o, L2, Lb, Db, Ub):
+# a call, not inline="always": inlined, this choice made assemble three times slower
+@njit(cache=True)
+def stencil_band(o, L2, Lb, Db):
     """The Jacobian block band of row j's column j - 2 + o."""
     if o == 0:
         return L2
     if o == 1:
         return Lb
-    if o == 2:
-        return Db
-    return Ub
+    return Db
 
 
 @njit(cache=True)
 def add_friction_slope(w, i, j, k, inv_dt, c, hh, sw):
     """Add to row block i the Jacobian of a nodal force -k v_rel,j (k = -dF_j/dv_rel)."""
-    for o in range(4):
+    for o in range(3):
         dd = k * slip_velocity_slope(sw, j, o, c, inv_dt)
         if dd == 0.0:
             continue
-        blk = stencil_band(o, w.L2, w.Lb, w.Db, w.Ub)
+        blk = stencil_band(o, w.L2, w.Lb, w.Db)
         blk[i, 0, 0] += dd
         blk[i, 0, 1] += dd * hh
         blk[i, 1, 0] += dd * hh
@@ -412,18 +432,17 @@ def update_multipliers(lam, dx, inv_dt, mesh, p, w):
     the boundary) and stays within LAM_MAX of it, so g^{-1}(lam) stays finite.
     Returns the largest change.
     """
-    c, hh, vreg = p.speed, p.half_height, p.v_reg
+    c, hh = p.speed, p.half_height
     rl, sg, sw = w.rl, w.sg, mesh.sw
-    n = dx.shape[0]
     big = 0.0
     for j in range(mesh.c0, mesh.j2 + 1):
         dvrel = 0.0
-        for o in range(4):
+        for o in range(3):
             k = j - 2 + o
-            if 1 <= k <= n:
+            if k >= 1:
                 dvrel += (slip_velocity_slope(sw, j, o, c, inv_dt)
                           * (dx[k - 1, 0] + hh * dx[k - 1, 1]))
-        dl = sg[j] * (rl[j] + dvrel / vreg)
+        dl = sg[j] * (rl[j] + dvrel / p.regularisation)
         if lam[j] + dl >= 1.0:
             dl = 0.99 * (1.0 - lam[j])
         elif lam[j] + dl <= -1.0:
@@ -497,64 +516,10 @@ def stored_energy(state, mesh: Mesh, p: ModelParams) -> float:
     """Kinetic plus elastic energy E of the power balance (J)."""
     hb, he = mesh.hb, mesh.he
     kinetic = 0.5 * np.sum(hb * (p.mass * state.ud**2 + p.rotary_inertia * state.td**2))
-    elastic = 0.5 * (p.tension_eff * np.sum(np.diff(state.u) ** 2 / he)
-                     + p.bending_eff * np.sum(np.diff(state.theta) ** 2 / he)
+    elastic = 0.5 * (p.B * np.sum(np.diff(state.u) ** 2 / he)
+                     + p.A * np.sum(np.diff(state.theta) ** 2 / he)
                      + p.shear * np.sum(hb * state.theta**2))
     return float(kinetic + elastic)
-
-
-# ---------------------------------------------------------------------------
-# numpy twins (tests, the bench's peer)
-
-
-def strain_numpy(ub, sw, j):
-    """d/dx u_b at the friction nodes j (array) from the stencil weights sw."""
-    k = np.minimum(np.asarray(j)[..., None] + np.arange(-2, 2), len(ub) - 1)
-    return np.sum(sw[j] * ub[k], axis=-1)
-
-
-def forces_numpy(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, loads=None):
-    """Nodal forces and moments of the semi-discrete model, all but the inertia terms.
-
-    Returns (force on u, moment on theta) at the interior nodes and the nodal
-    friction forces; with lumped masses m = rho hbar, m_I = I hbar the model reads
-    m u_tt = force, m_I theta_tt = moment. Vectorised twin of :func:`assemble`, and
-    the right-hand side of the method-of-lines system (the bench's peer).
-    """
-    B, A, b2 = p.tension_eff, p.bending_eff, p.shear
-    rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
-    he, hb = mesh.he, mesh.hb
-    ub = u + hh * th
-    F = np.zeros_like(u)
-    j = np.arange(mesh.c0, mesh.j2 + 1)
-    vrel = ud[j] + hh * td[j] + c * strain_numpy(ub, mesh.sw, j) - mismatch(drive, t)
-    fs = p.friction_scale * friction_factor(drive, t)
-    F[j] = -mesh.wf[j] * fs * law_numpy(p.law, vrel / p.v_reg)[0]
-    sl = slice(1, -1)
-    gyro = 2.0 * c * hb[sl] / he[:-1]
-    fu = (B * np.diff(np.diff(u) / he) - rho * gyro * (ud[sl] - ud[:-2])
-          - p.damping * rho * hb[sl] * ud[sl] + F[sl])
-    ft = (A * np.diff(np.diff(th) / he) - b2 * hb[sl] * th[sl] - I * gyro * (td[sl] - td[:-2])
-          - p.damping * I * hb[sl] * td[sl] + hh * F[sl])
-    if loads is not None and len(loads.times):
-        k, *wts = hermite_weights(loads.times, t)
-        fu = fu + hb[sl] * (np.dot(wts, [loads.qu[k], loads.qu[k + 1], loads.dqu[k],
-                                          loads.dqu[k + 1]]))[sl]
-        ft = ft + hb[sl] * (np.dot(wts, [loads.qt[k], loads.qt[k + 1], loads.dqt[k],
-                                          loads.dqt[k + 1]]))[sl]
-    return fu, ft, F
-
-
-def residual_numpy(u, th, old: State, inv_dt, t, mesh: Mesh, p: ModelParams, drive,
-                   loads=None):
-    """Vectorised twin of :func:`assemble` (residual and nodal friction only)."""
-    ud = (u - old.u) * inv_dt
-    td = (th - old.theta) * inv_dt
-    fu, ft, F = forces_numpy(u, th, ud, td, t, mesh, p, drive, loads)
-    sl, hb = slice(1, -1), mesh.hb
-    ru = p.mass * hb[sl] * (ud[sl] - old.ud[sl]) * inv_dt - fu
-    rt = p.rotary_inertia * hb[sl] * (td[sl] - old.td[sl]) * inv_dt - ft
-    return np.column_stack([ru, rt]), F
 
 
 def blocks_to_dense(Lb, Db, Ub, L2=None):

@@ -37,8 +37,9 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from . import reference
 from .friction import is_exact
-from .model import Loads, State, add_stick_penalty, assemble, model_params
+from .model import State, model_params
 
 #: Up to this many elements the spectrum is computed whole (dense); above, see above.
 DENSE_ELEMENTS = 500
@@ -65,51 +66,18 @@ class Growth:
                 f"{-self.rate:.3g} 1/s")
 
 
-def blocks_to_sparse(Lb, Db, Ub, L2):
-    """CSR matrix of a block-banded Jacobian (2x2 blocks; L2 the second lower band)."""
-    n = Db.shape[0]
-    rows, cols, vals = [], [], []
-    for blocks, off in ((Db, 0), (Lb, -1), (L2, -2), (Ub, 1)):
-        i = np.arange(max(0, -off), min(n, n - off))
-        for a in range(2):
-            for b in range(2):
-                rows.append(2 * i + a)
-                cols.append(2 * (i + off) + b)
-                vals.append(blocks[i, a, b])
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(2 * n, 2 * n))
-
-
-def jacobian(disc, state: State, s: float):
-    """P(s) of the discretisation `disc` linearised about the steady `state` (sparse)."""
+def linearisation(disc, state: State):
+    """(M, C, K) of the semi-discrete model about the steady `state` (sparse; M diagonal),
+    from :func:`beltsim.physics.reference.linearisation`."""
     from ..problem.drive import Drive
-    from ..solvers.newton import Workspace
 
     P, num = disc.params, disc.numerics
     # the scene's own damping: numerics.acceleration belongs to the pseudo scheme's path
-    p = model_params(P, P.damping, num.fs, num.vreg, num.law_code)
-    N = disc.grid.n_elements
-    w = Workspace.allocate(N)
-    old = State(state.u.copy(), state.theta.copy(), state.lam.copy(), np.zeros(N + 1),
-                np.zeros(N + 1), np.zeros(N + 1))
-    lam = state.lam.copy()
-    fnode = np.zeros(N + 1)
-    assemble(state.u.copy(), state.theta.copy(), lam, fnode, old, s, 0.0, disc.mesh, p,
-             Drive.constant(P.v - P.c), Loads.none(N + 1), w, True)
-    if is_exact(p.law):  # the stuck nodes' constraint, as the semi-smooth Newton's stand-in
-        add_stick_penalty(w, s, p.friction_scale, disc.mesh, p)
-    return blocks_to_sparse(w.Lb, w.Db, w.Ub, w.L2)
-
-
-def linearisation(disc, state: State):
-    """(M, C, K) of the semi-discrete model about the steady `state` (sparse; M diagonal)."""
-    P = disc.params
-    hb = disc.grid.hbar[1:-1]
-    m = np.column_stack([P.rho * hb, P.I * hb]).ravel()
-    K = jacobian(disc, state, 0.0)
-    s0 = math.sqrt(np.abs(K.diagonal()).max() / m.max())
-    C = (jacobian(disc, state, s0) - jacobian(disc, state, -s0)) / (2.0 * s0)
-    return sp.diags(m).tocsr(), C.tocsr(), K
+    p = model_params(P, P.damping, num.friction_scale, num.regularisation, num.law_code)
+    rest = np.zeros_like(state.u)
+    return reference.linearisation(state.u, state.theta, rest, rest, 0.0, disc.mesh, p,
+                                   Drive.constant(P.v - P.c),
+                                   ratios=state.lam if is_exact(p.law) else None)
 
 
 def companion(M, C, K):

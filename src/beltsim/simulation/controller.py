@@ -144,7 +144,7 @@ class Simulation:
         # a steady solve's state is the final drive's, whatever the clock says
         mismatch = mismatch_at(self.disc.drive, self.t) if self.scheme.transient else None
         return DiscreteSolution(self.params, self.grid, self.state.u, self.state.theta,
-                                self.state.fnode, n.law_code, n.fs, self.state.ud,
+                                self.state.fnode, n.law_code, n.friction_scale, self.state.ud,
                                 self.state.td, mismatch,
                                 (self.disc.mesh.c0, self.disc.mesh.wf, self.disc.mesh.sw))
 

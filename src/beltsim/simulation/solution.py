@@ -23,7 +23,8 @@ import numpy as np
 
 from ..physics.friction import saturation
 from ..physics.grid import Grid
-from ..physics.model import contact_stencil, strain_numpy, traction
+from ..physics.model import contact_stencil, traction
+from ..physics.reference import strain
 from ..problem.analytic import AnalyticSolution
 from ..problem.scene import Params
 
@@ -51,8 +52,8 @@ def relative_error(value, exact) -> float:
 
 
 class DiscreteSolution:
-    def __init__(self, params: Params, grid: Grid, u, theta, fnode, law_code, fs, ud=None,
-                 td=None, mismatch=None, stencil=None):
+    def __init__(self, params: Params, grid: Grid, u, theta, fnode, law_code, friction_scale,
+                 ud=None, td=None, mismatch=None, stencil=None):
         self.params = params
         self.grid = grid
         self.u = np.asarray(u, dtype=float).copy()
@@ -63,7 +64,7 @@ class DiscreteSolution:
         self.fnode = np.asarray(fnode, dtype=float).copy()
         self.model = "stick" if params.friction == "stick" else "slip"
         self.law_code = law_code
-        self.fs = fs
+        self.friction_scale = friction_scale
         # v(t) - c at the state's time (the drive's final value by default)
         self.mismatch = params.v - params.c if mismatch is None else float(mismatch)
         # the friction nodes, their weights and slip-velocity stencils (physics.model;
@@ -97,7 +98,8 @@ class DiscreteSolution:
         if self._slides is None:
             s = np.zeros_like(self.fnode, dtype=bool)
             on = self.wf > 0.0
-            s[on] = np.abs(self.fnode[on] / self.wf[on]) / self.fs >= saturation(self.law_code)
+            s[on] = (np.abs(self.fnode[on] / self.wf[on]) / self.friction_scale
+                     >= saturation(self.law_code))
             self._slides = s
         return self._slides
 
@@ -158,7 +160,7 @@ class DiscreteSolution:
         """x* read from node p's force, clipped to its volume [a, b], and how far
         inside it lies (min(x* - a, b - x*) / (b - a))."""
         a, b = (float(v) for v in self._control_volume(p))
-        fslip = float(np.sign(self.fnode[self.grid.j2])) * self.fs
+        fslip = float(np.sign(self.fnode[self.grid.j2])) * self.friction_scale
         fp = float(self.fnode[p])
         fit = self._stick_fit(p)
         xs = 0.5 * (a + b)
@@ -188,7 +190,7 @@ class DiscreteSolution:
         j = np.arange(self.c0, g.j2 + 1)
         hh = 0.5 * P.h
         ub = self.u + hh * self.theta
-        vrel = (self.ud[j] + hh * self.td[j] + P.c * strain_numpy(ub, self.sw, j)
+        vrel = (self.ud[j] + hh * self.td[j] + P.c * strain(ub, self.sw, j)
                 - self.mismatch)
         return float(-np.dot(self.fnode[j], vrel))
 
@@ -241,7 +243,7 @@ class DiscreteSolution:
         s = self._sliding()
         slip = float(self.fnode[s].sum())
         if p is not None:  # the sliding part of the partly stuck node
-            slip += float(np.sign(self.fnode[self.grid.j2]) * self.fs
+            slip += float(np.sign(self.fnode[self.grid.j2]) * self.friction_scale
                           * (self._control_volume(p)[1] - xs))
         return {"model": "slip", "inertia": self.params.inertia, "total_friction": total,
                 "concentrated_force": None, "distributed_friction": None,

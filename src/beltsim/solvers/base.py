@@ -44,7 +44,8 @@ class Discretisation:
         self.numerics: Numerics = num
         self.grid: Grid = grid if grid is not None else build_grid(scene, num)
         self.mesh: Mesh = mesh_of(self.grid)
-        self.model: ModelParams = model_params(P, P.damping + num.acceleration, num.fs, num.vreg,
+        self.model: ModelParams = model_params(P, P.damping + num.acceleration,
+                                               num.friction_scale, num.regularisation,
                                                num.law_code)
         self.drive = drive_of(scene, num.ramp_time)
         self.loads: Loads = Loads.none(self.grid.n_elements + 1)

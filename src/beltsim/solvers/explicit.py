@@ -215,10 +215,10 @@ def coefficients(dt, mesh, p):
         piv = 2.0 / dt + p.damping + g
         co.P[j] = (2.0 / dt) / piv
         co.Ql[j] = g / piv
-        co.ar[j] = dt * p.tension_eff / (m * he[j])
-        co.al[j] = dt * p.tension_eff / (m * he[j - 1])
-        co.br[j] = dt * p.bending_eff / (mi * he[j])
-        co.bl[j] = dt * p.bending_eff / (mi * he[j - 1])
+        co.ar[j] = dt * p.B / (m * he[j])
+        co.al[j] = dt * p.B / (m * he[j - 1])
+        co.br[j] = dt * p.A / (mi * he[j])
+        co.bl[j] = dt * p.A / (mi * he[j - 1])
         co.fm[j] = dt / m
         co.fi[j] = dt * hh / mi
         co.kb[j] = co.fm[j] + hh * co.fi[j]
@@ -227,7 +227,7 @@ def coefficients(dt, mesh, p):
         co.a0[j], co.a1[j] = ALPHA * dt * co.t0[j], ALPHA * dt * co.t1[j]
         co.tr[j] = ALPHA * dt * co.t2[j]
         co.fh[j] = wf[j] * p.friction_scale
-        co.kap[j] = (A_EST + co.tr[j]) * co.kb[j] * co.fh[j] / p.v_reg
+        co.kap[j] = (A_EST + co.tr[j]) * co.kb[j] * co.fh[j] / p.regularisation
     return co
 
 
@@ -241,7 +241,7 @@ def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, ff, co, mesh, 
     transport reaches nodes j-2 and j-1 (mesh.sw): their increments of this kick are
     known when node j is solved (upstream of c0, the kick without friction).
     """
-    c0, j2, hh, code, ivreg = mesh.c0, mesh.j2, p.half_height, p.law, 1.0 / p.v_reg
+    c0, j2, hh, code, inv_reg = mesh.c0, mesh.j2, p.half_height, p.law, 1.0 / p.regularisation
     smooth = code == TANH or code == SQRT
     # the slip velocity's estimate but for this kick's friction, into bb (one pass
     # without a chain from node to node)
@@ -270,7 +270,7 @@ def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, ff, co, mesh, 
         else:
             g0, gp = 0.0, 0.0
         inv = 1.0 / (1.0 + kap * gp)
-        sp = known * ivreg
+        sp = known * inv_reg
         ds = (sp - s0 - kap * g0) * inv
         edge = 1e-15 * (abs(sp) + kap)
         if (smooth and abs(s0 - sp) <= kap and abs(ds) <= SMALL_STEP * (1.0 + abs(s0))
@@ -413,9 +413,9 @@ def _gyro_symbol(c, h, kh):
 def _transport_symbol(c, h, kh):
     """c d/dx of the slip velocity on a uniform grid (1/s), for the mode e^{i kh j}: the
     model's stencil (physics.model.contact_stencil) read at an inner contact node of a
-    uniform grid; (3 - 4 e^{-i kh} + e^{-2 i kh}) / (2 h) for the three-point "bdf2"."""
+    uniform grid: (3 - 4 e^{-i kh} + e^{-2 i kh}) / (2 h)."""
     _, _, sw = contact_stencil(h * np.arange(8.0), 2, 6)
-    return c * sum(sw[4, o] * np.exp(1j * kh * (o - 2)) for o in range(4))
+    return c * sum(sw[4, o] * np.exp(1j * kh * (o - 2)) for o in range(3))
 
 
 def _amplification_matrices(params, h, dt, damping, kh, z):
@@ -544,10 +544,6 @@ class ExplicitScheme(Scheme):
     def __init__(self, disc):
         super().__init__(disc)
         P, num, grid = disc.params, self.numerics, disc.grid
-        if np.any(disc.mesh.sw[:, 3] != 0.0):
-            # a stencil reaching downstream (j + 1) is not known in the sweep along the flow
-            raise SceneError("numerics.integrator: the explicit scheme needs an upwind "
-                             "transport stencil in the slip velocity")
         limit = explicit_stable_dt(P, grid.h_min, disc.model.damping)
         if not limit > 0.0:
             raise SceneError("numerics.integrator", "the explicit scheme has no stable step "

@@ -38,7 +38,7 @@ import numpy as np
 from numba import njit
 
 from ..physics.friction import EXACT
-from ..physics.model import LAM_MAX, POWER_TERMS, power_terms
+from ..physics.model import LAM_MAX, POWER_TERMS, power_terms, rate_part
 from ..problem.drive import friction_factor
 from .newton import FAILED, NONFINITE, OK, NewtonScheme, block_substitute, newton
 from .registry import register
@@ -70,26 +70,12 @@ class History(NamedTuple):
 def filtered_error(e, a0, fs, mesh, p, w, out):
     """Solve J e_f = T e in place of ``e`` (n, 2); J: the step's Newton matrix, T: its a0 part.
 
-    J is applied through the block LU the Newton solve left in ``w``, T takes the
-    friction slopes of that J (w.sgf); fs: the friction scale at the step's time (f*
-    times the profile's factor).
+    J is applied through the block LU the Newton solve left in ``w``, T
+    (:func:`beltsim.physics.model.rate_part`) takes the friction slopes of that J
+    (w.sgf); fs: the friction scale at the step's time (f* times the profile's factor).
+    ``out`` receives T e.
     """
-    n = e.shape[0]
-    rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
-    kin = a0 * a0 + p.damping * a0
-    he, hb = mesh.he, mesh.hb
-    for i in range(n):
-        j = i + 1
-        ul = e[i - 1, 0] if i > 0 else 0.0
-        tl = e[i - 1, 1] if i > 0 else 0.0
-        gyro = a0 * 2.0 * c * hb[j] / he[j - 1]
-        out[i, 0] = kin * rho * hb[j] * e[i, 0] + rho * gyro * (e[i, 0] - ul)
-        out[i, 1] = kin * I * hb[j] * e[i, 1] + I * gyro * (e[i, 1] - tl)
-        if mesh.c0 <= j <= mesh.j2:
-            k = mesh.wf[j] * fs * w.sgf[j] / p.v_reg * a0
-            eb = e[i, 0] + hh * e[i, 1]
-            out[i, 0] += k * eb
-            out[i, 1] += hh * k * eb
+    rate_part(e, a0, fs, w.sgf, mesh, p, out)
     block_substitute(w, out, e)
 
 

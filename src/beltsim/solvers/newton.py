@@ -380,7 +380,7 @@ class NewtonScheme(Scheme):
         super().__init__(disc)
         num = self.numerics
         self.work = Workspace.allocate(disc.grid.n_elements, is_exact(disc.model.law))
-        self.settings = NewtonSettings(num.newton_tol, num.newton_max_it)
+        self.settings = NewtonSettings(num.newton_tol, num.newton_max_iterations)
         # the previous step's state (with inv_dt = 0, the steady equations ignore it)
         self.old = disc.new_state()
 

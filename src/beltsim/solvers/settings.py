@@ -80,7 +80,7 @@ MIN_MISMATCH = 1e-8  # smallest nonzero |v/c - 1| a run accepts
 DEFAULT_MAX_WORK = 2e10  # node-steps of an explicit run
 EXPLICIT_RATE = 3e7  # node-steps per second of the explicit kernel (bench), for messages
 MEMORY_PER_NODE = 600  # bytes a grid node costs a run at its peak
-MIN_VREG = 1e-12  # smallest regularisation velocity, relative to c
+MIN_REGULARISATION = 1e-12  # smallest regularisation velocity, relative to c
 DEFAULT_ADHESION_LAYER = 1e-6  # delta / L
 # Smallest factor on the default v_reg and delta as the grid is refined (10 times the
 # default elements): 1e-6 |v - c| and 1e-8 L were measured clean to 4000 elements, where
@@ -98,13 +98,13 @@ class Numerics:
     t_end: float
     ramp_time: float
     law: str
-    vreg: float  # regularisation velocity (law argument scale)
-    fs: float  # friction scale: f = -fs g(v_rel / vreg)
+    regularisation: float  # the friction law's velocity scale: v_reg, v_aug (exact), 1 (linear)
+    friction_scale: float  # f_s in f = -f_s g(v_rel / v_reg)
     acceleration: float  # numerical damping (1/s) of the pseudo-transient scheme
     steady_tol: float
     snapshot_interval: float | None
     newton_tol: float = 1e-9
-    newton_max_it: int = 30
+    newton_max_iterations: int = 30
     time_tol: float = DEFAULT_TIME_TOL
     max_work: float = DEFAULT_MAX_WORK
     settle_time: float = 0.0  # when the drive stops changing (steady tests start there)
@@ -144,26 +144,29 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
     dv = abs(P.v - P.c)
     if dv == 0.0 or period_of(scene) is not None:
         dv = largest_mismatch(scene)
-    default_vreg = 1e-4 * dv if dv > 0 else 1e-6 * P.c
+    default_regularisation = 1e-4 * dv if dv > 0 else 1e-6 * P.c
     if nm.get("friction_law") == "exact":
         # v_aug: the augmentation velocity, numerical only (physics.friction). For
         # adhesion f_s makes f_s / v_aug the default adhesion layer's slope B / (c delta)
-        vreg = AUGMENTATION * default_vreg
+        regularisation = AUGMENTATION * default_regularisation
         if P.friction == "coulomb":
-            law, fs = "exact", P.fstar
+            law, friction_scale = "exact", P.fstar
         else:
-            law, fs = "adhesion", P.B * vreg / (P.c * DEFAULT_ADHESION_LAYER * P.L)
+            law = "adhesion"
+            friction_scale = P.B * regularisation / (P.c * DEFAULT_ADHESION_LAYER * P.L)
     elif P.friction == "coulomb":
-        vreg = nm.get("regularisation", max(default_vreg * refine, MIN_VREG * P.c))
-        law, fs = nm.get("friction_law", "tanh"), P.fstar
-        if vreg < MIN_VREG * P.c:
-            raise SceneError("numerics.regularisation", f"must be >= {MIN_VREG:g} c = "
-                             f"{MIN_VREG * P.c:.3g} m/s (below it slip velocities drown in "
-                             f"round-off), got {vreg!r}")
+        regularisation = nm.get("regularisation", max(default_regularisation * refine,
+                                                      MIN_REGULARISATION * P.c))
+        law, friction_scale = nm.get("friction_law", "tanh"), P.fstar
+        if regularisation < MIN_REGULARISATION * P.c:
+            raise SceneError("numerics.regularisation",
+                             f"must be >= {MIN_REGULARISATION:g} c = "
+                             f"{MIN_REGULARISATION * P.c:.3g} m/s (below it slip velocities "
+                             f"drown in round-off), got {regularisation!r}")
     else:
         delta = nm.get("adhesion_layer", DEFAULT_ADHESION_LAYER * P.L * refine)
-        law, vreg = "linear", 1.0
-        fs = P.B / (P.c * delta)
+        law, regularisation = "linear", 1.0
+        friction_scale = P.B / (P.c * delta)
     accelerated = registry.get(integrator).accelerated
     if "acceleration" in nm and not accelerated:
         allowed = " | ".join(f'"{n}"' for n in registry.names()
@@ -181,11 +184,12 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         integrator=integrator,
         elements=elements,
         grading=nm.get("grading", DEFAULT_GRADING),
-        dt=dt, t_end=t_end, ramp_time=ramp_time, law=law, vreg=vreg, fs=fs,
+        dt=dt, t_end=t_end, ramp_time=ramp_time, law=law, regularisation=regularisation,
+        friction_scale=friction_scale,
         acceleration=acceleration, steady_tol=nm.get("steady_tol", 1e-6),
         snapshot_interval=nm.get("snapshot_interval"),
         newton_tol=nm.get("newton_tol", 1e-9),
-        newton_max_it=nm.get("newton_max_iterations", 30),
+        newton_max_iterations=nm.get("newton_max_iterations", 30),
         time_tol=nm.get("time_tol", DEFAULT_TIME_TOL),
         settle_time=settle_time(scene, ramp_time),
         max_work=nm.get("max_work", DEFAULT_MAX_WORK),

@@ -64,7 +64,7 @@ def saddle_system(lam, inv_dt, fs, mesh, p, w, s):
     friction nodes whose stick/slip state differs from the previous call's.
     """
     n = w.R.shape[0]
-    c, hh, vaug = p.speed, p.half_height, p.v_reg
+    c, hh, vaug = p.speed, p.half_height, p.regularisation
     changed = 0
     for i in range(n):
         for a in range(3):
@@ -98,14 +98,13 @@ def saddle_system(lam, inv_dt, fs, mesh, p, w, s):
             s.R[i, 2] = -(lam[j] - math.copysign(1.0, lam[j] + w.rl[j]))
             continue
         s.R[i, 2] = -w.rl[j]
-        for o in range(4):
-            q = j - 2 + o
-            if q < 1 or q > n:
+        for o in range(3):
+            if j - 2 + o < 1:
                 continue
             dd = slip_velocity_slope(mesh.sw, j, o, c, inv_dt) / vaug
             if dd == 0.0:
                 continue
-            blk = stencil_band(o, s.L2, s.Lb, s.Db, s.Ub)
+            blk = stencil_band(o, s.L2, s.Lb, s.Db)
             blk[i, 2, 0] += dd
             blk[i, 2, 1] += dd * hh
     return changed

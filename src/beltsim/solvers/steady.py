@@ -57,7 +57,8 @@ class SteadyScheme(NewtonScheme):
         smooth = regularised(model)  # the model itself for a regularised law
         try:
             if smooth.dual:
-                self.disc.model = smooth._replace(v_reg=REGULARISATION_START * smooth.v_reg)
+                self.disc.model = smooth._replace(
+                    regularisation=REGULARISATION_START * smooth.regularisation)
                 self._continue_in_speed(state)
             self.disc.model = smooth
             self._continue_in_speed(state)
