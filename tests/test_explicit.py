@@ -5,8 +5,8 @@ import pytest
 from scipy.optimize import brentq
 
 import beltsim
-from beltsim.physics.friction import law_numpy
 from beltsim.physics import reference
+from beltsim.physics.friction import law_numpy
 from beltsim.physics.model import Loads, State
 from beltsim.problem.drive import mismatch
 from beltsim.problem.scene import Scene

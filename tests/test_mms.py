@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import beltsim
-from beltsim.physics.friction import law_numpy
 from beltsim.physics import reference
+from beltsim.physics.friction import law_numpy
 from beltsim.physics.model import Loads
 from beltsim.problem.drive import friction_factor, mismatch
 from helpers import scene_path

@@ -19,9 +19,9 @@ from beltsim.problem.drive import Drive
 from beltsim.problem.scene import shipped_scene
 from beltsim.simulation import trackers
 from beltsim.solvers.newton import Workspace
-from validation import random_scenes as rs
 from beltsim.studies import stability
 from beltsim.studies.stability import ACCEPTED, Case, CellStatus, stability_cell
+from validation import random_scenes as rs
 
 pytestmark = pytest.mark.verification
 

@@ -105,10 +105,10 @@ class State(NamedTuple):
     fnode: np.ndarray
 
     @classmethod
-    def zeros(cls, n_nodes: int) -> "State":
+    def zeros(cls, n_nodes: int) -> State:
         return cls(*(np.zeros(n_nodes) for _ in cls._fields))
 
-    def copy(self) -> "State":
+    def copy(self) -> State:
         return State(*(a.copy() for a in self))
 
     def assign(self, other) -> None:
@@ -132,7 +132,7 @@ class Loads(NamedTuple):
     dqt: np.ndarray
 
     @classmethod
-    def none(cls, n_nodes: int) -> "Loads":
+    def none(cls, n_nodes: int) -> Loads:
         empty = np.zeros((0, n_nodes))
         return cls(np.zeros(0), empty, empty, empty, empty)
 

@@ -57,7 +57,7 @@ class Growth:
     frequency: float  # |Im lambda| / (2 pi) (Hz)
     elements: int  # of the grid the eigenvalue belongs to
     method: str  # "dense", or "shift-invert near the N-element mode"
-    coarse: "Growth | None" = None  # the coarse grid's, when the method is shift-invert
+    coarse: Growth | None = None  # the coarse grid's, when the method is shift-invert
 
     def describe(self) -> str:
         return (f"a mode at {self.frequency:.4g} Hz grows at {self.rate:.3g} 1/s"

@@ -71,7 +71,7 @@ class Workspace(NamedTuple):
     saddle: Saddle  # the exact laws' 3x3 system (empty for the regularised ones)
 
     @classmethod
-    def allocate(cls, n_elements: int, exact: bool = False) -> "Workspace":
+    def allocate(cls, n_elements: int, exact: bool = False) -> Workspace:
         N, n = n_elements, n_elements - 1
         return cls(R=np.zeros((n, 2)), Lb=np.zeros((n, 2, 2)), L2=np.zeros((n, 2, 2)),
                    Db=np.zeros((n, 2, 2)),

@@ -43,14 +43,14 @@ class Saddle(NamedTuple):
     active: np.ndarray  # (N + 1) 1 where the node sticks, at the last assembly
 
     @classmethod
-    def allocate(cls, n_elements: int) -> "Saddle":
+    def allocate(cls, n_elements: int) -> Saddle:
         n = max(n_elements - 1, 0)
         z = np.zeros
         return cls(z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)),
                    z((n, 3, 3)), z((n, 3, 3)), z((n, 3)), z((n, 3)), z(n_elements + 1))
 
     @classmethod
-    def empty(cls) -> "Saddle":
+    def empty(cls) -> Saddle:
         return cls.allocate(0)
 
 

@@ -50,7 +50,8 @@ def richardson(scene: Scene, reference=None):
         return (4.0 * fine - coarse) / 3.0
 
     ext = DiscreteSolution(s1.params, s1.grid, ext_of(s2.u[::2], s1.u),
-                           ext_of(s2.theta[::2], s1.theta), s1.fnode, s1.law_code, s1.friction_scale)
+                           ext_of(s2.theta[::2], s1.theta), s1.fnode, s1.law_code,
+                           s1.friction_scale)
     err = compare(ext, ref)
     err["total_friction"] = relative_error(ext_of(s2.total_friction, s1.total_friction),
                                            ref.total_friction)
