@@ -178,10 +178,11 @@ def test_cli_numerical_failure_exits_3_with_summary_and_last_good_state(tmp_path
 @pytest.mark.cli
 @pytest.mark.verification
 def test_stability_command_quick_matrix(tmp_path):
-    """A coarse matrix: every cell converges, is refused before running with a reason, or
-    does not apply; nothing diverges, hangs or writes NaN as a result."""
+    """A coarse matrix (the issue's command): every cell reaches its grid's steady state
+    (the steady scheme's, within DISCRETE_BOUNDS), is refused before running with a
+    reason, or does not apply; nothing diverges, hangs or writes NaN as a result."""
     proc = subprocess.run([sys.executable, "-m", "beltsim.cli", "stability", "--elements",
-                           "120", "--out", str(tmp_path)], capture_output=True, text=True,
+                           "60", "--out", str(tmp_path)], capture_output=True, text=True,
                           timeout=900)
     import csv
     rows = list(csv.DictReader((tmp_path / "stability.csv").open()))
@@ -189,12 +190,10 @@ def test_stability_command_quick_matrix(tmp_path):
     assert len(rows) == len(cases) * len(solvers.names())
     spans = {c.name for c in cases if c.span}
     for r in rows:
-        # 120 elements are too coarse for the default grid's bounds: out of bounds is
-        # allowed here, a divergence or an unconverged run is not; the undamped cases
-        # run a fixed span and must stay bounded
+        # the undamped cases run a fixed span and must stay bounded
         steady = r["scheme"] == "steady"  # no path: judged on its steady state
         allowed = ("bounded",) if r["case"] in spans and not steady else (
-            "converged", "out of bounds", "refused", "not applicable")
+            "converged", "refused", "not applicable")
         assert r["status"] in allowed, r
         if r["status"] in ("refused", "not applicable"):
             assert r["reason"]
@@ -207,10 +206,7 @@ def test_stability_command_quick_matrix(tmp_path):
                        "speeds)", "very slow belt (c = 1e-3 m/s)"}
     md = (tmp_path / "stability.md").read_text()
     assert md.count("\n") == len(rows) + 2
-    # exit 1 exactly when a cell is out of bounds (or worse)
-    outside = any(r["status"] not in ("converged", "bounded", "refused", "not applicable")
-                  for r in rows)
-    assert proc.returncode == (1 if outside else 0), proc.stderr
+    assert proc.returncode == 0, proc.stderr
 
 
 @pytest.mark.cli

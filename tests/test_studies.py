@@ -220,3 +220,22 @@ def test_richardson_extrapolation_beats_second_order_on_the_stick_scene():
             for n in (125, 250)]
     for key in ("total_friction", "u", "concentrated_force"):
         assert errs[0][key] / errs[1][key] > 6.0, key
+
+
+@pytest.mark.unit
+def test_a_discrete_reference_measures_states_on_its_own_grid():
+    """A coarse matrix compares each scheme with the steady scheme's state on the same
+    grid: a state 1e-4 off in u is out of DISCRETE_BOUNDS, the state itself is not."""
+    from beltsim.simulation.solution import DiscreteReference, DiscreteSolution, compare
+    from beltsim.studies.stability import DISCRETE_BOUNDS
+    sol = Simulation(load_scene(scene_path("paper_slip"), ["numerics.elements=60",
+                                                           "numerics.integrator=steady"])
+                     ).run().solution
+    ref = DiscreteReference(sol)
+    assert all(v == 0.0 for v in compare(sol, ref).values() if v is not None)
+    off = DiscreteSolution(sol.params, sol.grid, sol.u * (1 + 1e-4), sol.theta, sol.fnode,
+                           sol.law_code, sol.friction_scale)
+    err = compare(off, ref)
+    assert err["u"] == pytest.approx(1e-4) and err["u"] > DISCRETE_BOUNDS["u"]
+    with pytest.raises(ValueError, match="own grid"):
+        ref.fields(sol.x[:-1])
