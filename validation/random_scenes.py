@@ -57,7 +57,10 @@ SCENE_KEYS = {
     "contact": ("start", "end", "friction", "max_friction"),
     "physics": ("inertia", "damping"),
 }
-PAPER_ELEMENTS = 1000  # the grid of the paper scenes (L = 1 m) that BOUNDS were set on
+# BOUNDS' slip-start bound, 5 mm, is five mean element lengths of the 1000-element grid
+# of the paper scenes (L = 1 m) it was set on (the default grid then; 600 elements now):
+# scene_bounds keeps it at 5 L / N on any grid
+PAPER_ELEMENTS = 1000
 _BASE = {"stick": "paper_inertia", "coulomb": "paper_slip"}  # shipped scenes with these keys
 #: Columns of random.csv.
 COLUMNS = ("index", "scheme", "status", "reason_key", "friction", "inertia", "damping",
@@ -233,11 +236,10 @@ def scene_bounds(scene: Scene, elements: int) -> dict:
     """stability.BOUNDS with the slip start's (in metres) scaled to the grid.
 
     The paper's 5 mm on 1000 elements over 1 m is five mean element lengths: the slip
-    start sits on element boundaries (its error jumps between 4e-6 and 1e-3 m there), so
-    its bound is 5 L / N. Measured on random scene 56 of seed 1 (L = 42.5 m, 1000
-    elements of 42 mm on average): 9.8 mm, 0.23 of a mean element, out of the paper's
-    bound. The relative bounds stay: they hold on the default grid, which resolves the
-    scene's shortest decay length as it does the paper's.
+    start's error is a fraction of an element, so on a long domain's coarse elements a
+    bound in metres would fail where the scene is resolved as well as the paper's; its
+    bound is 5 L / N. The relative bounds stay: they hold on the default grid, which
+    resolves the scene's shortest decay length as it does the paper's.
     """
     out = dict(BOUNDS)
     out["slip_start"] = BOUNDS["slip_start"] * scene.params.L * (PAPER_ELEMENTS / elements)

@@ -40,6 +40,7 @@ def _shade_contact(ax, P):
 
 
 def two_panel(field, number, ylabel, title, sols, sims, path):
+    """One of Figures 2-6: a field, inertia against none and slip against none."""
     plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.3), constrained_layout=True)
     for ax, cases, sub in zip(axes, PANELS, PANEL_TITLES):
@@ -71,6 +72,7 @@ def two_panel(field, number, ylabel, title, sols, sims, path):
 
 
 def fig7(sols, sims, path):
+    """Figure 7: the rotation for three friction limits against perfect adhesion."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 4.6), constrained_layout=True)
     _shade_contact(ax, sols["inertia"].params)

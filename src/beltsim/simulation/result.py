@@ -13,6 +13,8 @@ from .solution import DiscreteSolution, compare
 
 
 class RunStatus(enum.Enum):
+    """How a run ended."""
+
     CONVERGED = "converged"  # steady state reached
     REACHED_END = "reached t_end"  # t_end reached before steady state
     FAILED = "failed"  # stopped on a numerical failure; the state is the last good one
@@ -21,6 +23,8 @@ class RunStatus(enum.Enum):
 
 @dataclass
 class RunResult:
+    """The outcome of a run: status, final state, history, statistics and records."""
+
     scene: Scene
     numerics: Numerics
     status: RunStatus
