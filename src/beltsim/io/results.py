@@ -23,6 +23,7 @@ CHECKPOINT = "checkpoint.npz"
 
 
 def write_fields(path, x, fields: dict) -> Path:
+    """Write fields.csv: x and the fields of FIELDS_HEADER."""
     return write_csv(path, FIELDS_HEADER, [x] + [fields[k] for k in FIELDS_HEADER[1:]])
 
 
@@ -53,8 +54,8 @@ def save_run(result, out, complete: bool = True) -> list[Path]:
 def write_snapshots(path, result) -> Path:
     """States at every snapshot interval, compressed, in single precision.
 
-    Arrays: ``x`` (nodes), ``t`` (times), ``u``, ``theta``, ``friction`` (element
-    traction in N/m at the downstream node, as in fields.csv), each (times, nodes);
+    Arrays: ``x`` (nodes), ``t`` (times), ``u``, ``theta``, ``friction`` (the traction
+    in N/m at the friction nodes, as in fields.csv), each (times, nodes);
     ``scene`` (the scene as TOML text). Single precision keeps a long run's file small
     and is far finer than a plot.
     """

@@ -29,11 +29,9 @@ LAW_CODES = {"linear": LINEAR, "tanh": TANH, "sqrt": SQRT, "ramp": RAMP, "exact"
 
 
 # v_aug over the default regularisation velocity (settings): v_aug = |v - c|, the scale
-# of the slip velocities. The stick/slip test lam + v_rel / v_aug then follows the
-# ratio near the slip front: with v_aug = 1e-4 |v - c| a node whose slip velocity had
-# the wrong sign in one iterate jumped to the opposite slip, skipping stick, and the
-# semi-smooth Newton cycled on the paper slip scene; from 1e-2 |v - c| up it converges
-# in two iterations from the regularised steady state (200 elements)
+# of the slip velocities, so the stick/slip test lam + v_rel / v_aug follows the ratio
+# near the slip front; a much smaller v_aug lets a node whose slip velocity has the
+# wrong sign in one iterate jump to the opposite slip, and the iteration cycles
 AUGMENTATION = 1e4
 
 

@@ -60,10 +60,9 @@ def make_grid(L: float, x1: float, x2: float, elements: int, grading: float = 1.
     towards x2; those inside (x1, x2) are also breakpoints, nodes of the grid, where
     each side gets at least ANCHOR_ELEMENTS elements of its share (else the point is
     only graded towards). A node at the slip start x* keeps the front inside the same
-    control volume, at its node, as the grid is refined: the steady errors of the
-    slip scene then fall at a steady order 2.0 (paper slip, exact law, 250 ... 4000
-    elements), where with x* anywhere in its cell successive orders scattered from
-    0.05 to 3.7 (theta) as x* crossed control-volume edges.
+    control volume, at its node, as the grid is refined, so the observed orders of the
+    slip scene stay steady instead of scattering as x* crosses control-volume edges
+    (docs/theory/discretisation.md, "The grid").
     """
     if elements < MIN_ELEMENTS:
         raise SceneError("numerics.elements", f"must be >= {MIN_ELEMENTS}, got {elements}")

@@ -9,21 +9,19 @@ speed c, and D/Dt = d/dt + c d/dx. With B = b1 - rho c^2 and A = a - I c^2::
 
 Space: linear elements with lumped mass and shear (node-centred control
 volumes); the gyroscopic term 2 c u_xt is upwind, 2 rho c hbar_j (v_j - v_{j-1}) /
-h_{j-1} (the central, skew form leaves a mode that grows at the paper slip steady
-state, +2.5 1/s with the paper's damping: friction in the stick zone pumps the
-rotation; upwind, the slowest mode decays at 10 1/s; both vanish at steady state). The
-transport c d/dx u_b in the slip velocity is evaluated at the contact nodes x1 .. x2
-with the one-sided three-point (BDF2) derivative over x_{j-2}, x_{j-1}, x_j (second
-order on any grid; upwind, so its parasitic solution decays by ~1/3 per node
-downstream and never alternates), and the friction of node j acts on the contact part
-of its control volume (half volumes at x1 and x2: trapezoidal quadrature). Treated
-centrally (central differences, or element friction lumped half/half) this term makes
-the friction alternate in sign from node to node in stick zones, and Newton can land
-on spurious all-slip states; the two-point upwind form (element [x_{j-1}, x_j] lumped
-on node j, "upwind" in :func:`contact_stencil`) is smooth but first order. The
-stencil reaches node j - 2, so the Jacobian has a second lower block band. The
-damping d acts on local time derivatives only, so it vanishes at steady state
-(damping of the material strain rate would not, and would change the answer).
+h_{j-1}: the central, skew form leaves a mode that grows at the paper slip steady state
+(friction in the stick zone pumps the rotation), the upwind one damps it, and both
+vanish at steady state. The transport c d/dx u_b in the slip velocity is evaluated at
+the contact nodes x1 .. x2 with the one-sided three-point (BDF2) derivative over
+x_{j-2}, x_{j-1}, x_j (second order on any grid; upwind, so its parasitic solution
+decays by ~1/3 per node downstream and never alternates), and the friction of node j
+acts on the contact part of its control volume (half volumes at x1 and x2: trapezoidal
+quadrature). Treated centrally this term makes the friction alternate in sign from node
+to node in stick zones; the two-point upwind form is smooth but first order. The
+stencil reaches node j - 2, so the Jacobian has a second lower block band. The damping
+d acts on local time derivatives only, so it vanishes at steady state (damping of the
+material strain rate would not, and would change the answer). See
+docs/theory/discretisation.md.
 
 Time: the residual is written for backward Euler with ``inv_dt`` = 1/dt; with
 ``inv_dt`` = 0 it is the discrete steady problem. Interior nodes 1..N-1 carry

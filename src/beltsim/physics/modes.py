@@ -16,15 +16,16 @@ are those of the companion matrix [[0, 1], [-M^-1 K, -M^-1 C]] (4 (N - 1) of the
 
 How the largest real part is found (:func:`growth_rate`):
 
-* grids up to DENSE_ELEMENTS elements: every eigenvalue, dense (LAPACK; 27 s at 1000
-  elements, 0.3 s at 200, measured on one core);
+* grids up to DENSE_ELEMENTS elements: every eigenvalue, dense (LAPACK; its cost grows
+  as the cube of the grid);
 * finer grids: the dense spectrum of the same scene on DENSE_ELEMENTS elements gives the
-  candidate mode, then ARPACK in shift-invert mode finds the NEAREST eigenvalues of the
-  fine grid around it. This can miss a mode that is unstable on the fine grid only (the
-  coarse grid's upwind gyroscopic term damps more: on the outlet case +4.3 1/s at 1000
-  elements, +16.3 converged), so it errs towards "stable", never towards "unstable" on
-  a grid where no unstable mode exists: an unstable eigenvalue it reports is one of the
-  fine grid's.
+  candidate modes, then ARPACK in shift-invert mode finds the NEAREST eigenvalues of the
+  fine grid around each. This can miss a mode that is unstable on the fine grid only
+  (the coarse grid's upwind gyroscopic term damps more), so it errs towards "stable",
+  never towards "unstable" on a grid where no unstable mode exists: an unstable
+  eigenvalue it reports is one of the fine grid's.
+
+See docs/theory/stability.md.
 """
 
 from __future__ import annotations

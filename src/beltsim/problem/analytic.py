@@ -40,7 +40,7 @@ eps and the moment balance by theta' and integrating over [0, L] gives, for both
 the global balance D = c e0 F_tot + (c/2) [B eps^2 + A theta'^2] from 0 to L, jumps
 included. In perfect adhesion eps_b jumps at x2 by [[eps_b]] = -F (1/B + h^2/(4A)), so the
 material leaves the surface sliding, and the balance gives D = (c/2) F^2 (1/B + h^2/(4A)):
-F times the mean of the sliding speeds on either side, 0 and c |[[eps_b]]|. It is the
+F times the mean of the sliding speeds on either side, 0 and c abs([[eps_b]]). It is the
 f* -> infinity limit of the slip zone, of width F/f*, across which eps_b - e0 runs
 linearly from 0 to [[eps_b]].
 """
@@ -61,6 +61,8 @@ FIELDS = ("u", "theta", "strain", "tension", "moment", "friction")
 
 @dataclass(frozen=True)
 class Segment:
+    """A segment [p, q] of the steady solution: free, stick or slip, with its decay rate."""
+
     p: float
     q: float
     kind: str  # "free", "stick", "slip"
@@ -257,10 +259,10 @@ class AnalyticSolution:
     def slip_power(self) -> float:
         """Power dissipated by sliding (W, >= 0); the derivation is in the module docstring.
 
-        Slip model: the closed-form integral of f* c |eps_b - e0| over the slip zone.
+        Slip model: the closed-form integral of f* c abs(eps_b - e0) over the slip zone.
         Perfect adhesion: the distributed traction does no work (no sliding where it
         acts), but the concentrated force acts where the sliding speed jumps from 0 to
-        c |[[eps_b]]| and dissipates (c/2) F^2 (1/B + h^2/(4A)).
+        c abs([[eps_b]]) and dissipates (c/2) F^2 (1/B + h^2/(4A)).
         """
         P = self.params
         if self.model == "stick":
@@ -466,7 +468,7 @@ def solve_slip(P: Params) -> AnalyticSolution:
 
 
 def _admissible(sol: AnalyticSolution, rtol=1e-7) -> bool:
-    """Coulomb's law holds: |f| <= f* in stick, and sliding opposes the traction."""
+    """Coulomb's law holds: abs(f) <= f* in stick, and sliding opposes the traction."""
     P = sol.params
     for i, seg in enumerate(sol.segments):
         if seg.length <= 0.0:

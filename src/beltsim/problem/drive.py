@@ -31,6 +31,8 @@ from .scene import profile_extremes
 
 
 class Profile(NamedTuple):
+    """One quantity over time as the kernels read it: a table, a sine or a number."""
+
     times: np.ndarray  # table times (empty: not a table)
     values: np.ndarray  # table values
     level: float  # a number's value, or a sine's mean
@@ -44,6 +46,8 @@ class Profile(NamedTuple):
 
 
 class Drive(NamedTuple):
+    """The drive of a run: the surface speed's mismatch and the friction limit's factor."""
+
     speed: Profile  # v(t) - c (m/s)
     friction: Profile  # f*(t) / f* (1 for perfect adhesion)
 
@@ -143,7 +147,7 @@ def speed_ramped(scene) -> bool:
 
 
 def largest_mismatch(scene) -> float:
-    """max |v(t) - c| over the profile."""
+    """max abs(v(t) - c) over the profile."""
     lo, hi = profile_extremes(_profiles(scene)[0])
     c = scene.params.c
     return max(abs(lo - c), abs(hi - c))

@@ -18,22 +18,20 @@ the belt is an axially moving bar (B = b1, no mass)::
 s the C2 smoothstep of :mod:`beltsim.problem.drive` (s(r) = r^3 (10 - 15 r + 6 r^2)
 on [0, 1]), T = ``numerics.ramp_time`` (default 2 L / c, as in
 :func:`beltsim.solvers.settings.resolve`). Stick: v_rel = 0, any f ("stick" scenes,
-perfect adhesion) or |f| <= f* ("coulomb"); slip: f = -f* sign(v_rel).
+perfect adhesion) or abs(f) <= f* ("coulomb"); slip: f = -f* sign(v_rel).
 
-How thin is thin: the O(h^2) deviations are, relative to the strain scale |e0| =
-|v/c - 1| (total friction, strains),
+How thin is thin: the O(h^2) deviations are, relative to the strain scale abs(e0) =
+abs(v/c - 1) (total friction, strains)::
 
-    eta = (h/2)^2 max(b1 / a,  f* / (|e0| sqrt(a b2)))
+    eta = (h/2)^2 max(b1 / a,  f* / (abs(e0) sqrt(a b2)))
 
 (the first from a concentrated force or a stick layer, whose theta jumps by
 (h/2) F / a in slope; the second from the slip zone, where theta ~ h f* / (2 b2)
 varies over 1/beta = sqrt(a / b2); without f* only the first). A scene counts as
 thin when eta <= ``THIN_TOL`` = 1e-6, far below any grid error the comparison
 resolves; the paper's data with h = 1e-6 m and [stiffness] from h = 0.1 m give
-eta = 3e-10. The deviation is O(h^2), not O(h): measured with the exact steady
-solutions (:mod:`beltsim.problem.analytic`, any h) against this limit, the steady
-total friction of the paper's scenes with [stiffness] fixed deviates by 0.07 eta
-(perfect adhesion) and 0.02 eta (f* = 1e5 N/m) for h = 1e-2 ... 1e-5 m. Without
+eta = 3e-10. The deviation is O(eta), as the exact steady solutions
+(:mod:`beltsim.problem.analytic`, any h) confirm against this limit. Without
 [stiffness] a, b1, b2 follow h, b1 / a = 12 / h^2, and eta >= 3 whatever h: such a
 scene is refused.
 
@@ -97,13 +95,13 @@ Then, from (3)::
 
 Assumptions (checked; a scene outside them raises SceneError naming the key):
 
-(A1) monotone loading: the drive ramps monotonically (the smoothstep does), so m' has
-     one sign, and by (1) so does eps_in' (the filter of m' / c); |eps_in| grows
-     monotonically to |e0|.
-(A2) the stick traction stays below the limit: b1 max |eps_in'| / c < f*.
-(A3) a stick zone remains: L |e0| < (f* / b1) l (l / 2 + L - x2), l = x2 - x1 (else the
-     whole contact slides in the end, the stick condition at x1 that gives (1) is
-     lost, and this solution does not apply).
+* (A1) monotone loading: the drive ramps monotonically (the smoothstep does), so m'
+  has one sign, and by (1) so does eps_in' (the filter of m' / c); abs(eps_in) grows
+  monotonically to abs(e0).
+* (A2) the stick traction stays below the limit: b1 max abs(eps_in') / c < f*.
+* (A3) a stick zone remains: L abs(e0) < (f* / b1) l (l / 2 + L - x2), l = x2 - x1
+  (else the whole contact slides in the end, the stick condition at x1 that gives (1)
+  is lost, and this solution does not apply).
 
 Under them the fields built here meet every condition of the problem (the tests
 also check them by finite differences of u, not by these formulas): the traction in
@@ -119,8 +117,8 @@ is the root of the closed-form scalar equation (4), to 1e-15 L; the totals follo
 it in closed form. "Exact" refers to the limit problem: h -> 0 (the O(eta) of the
 scene's actual h is left out), unregularised Coulomb friction (v_reg -> 0) and perfect
 adhesion (adhesion layer delta -> 0); a simulation carries the errors of its v_reg and
-delta (the defaults make them O(1e-4) and O(1e-6) relative, measured 3e-6 at steady
-state for the stick scene) on top of its grid and time-step errors.
+delta on top of its grid and time-step errors. The derivation is also written out in
+docs/theory/exact-solutions.md, "The thin-belt transient".
 """
 
 from __future__ import annotations
@@ -239,7 +237,7 @@ class ThinBeltTransient:
         return (self.mismatch(t) - P.c * self.inlet_strain(t)) / P.x1
 
     def max_inlet_strain_rate(self):
-        """max |eps_in'| over t > 0 (attained during the ramp; then it decays)."""
+        """max abs(eps_in') over t > 0 (attained during the ramp; then it decays)."""
         if self.T <= 0.0:
             return abs(self.dv) / self.params.x1  # at t = 0+
         ts = np.linspace(0.0, self.T, 4001)
@@ -258,7 +256,7 @@ class ThinBeltTransient:
         return P.x1 * self.inlet_strain(tau) + self.mismatch_integral(tau, t)
 
     def _length_residual(self, x_star, t):
-        """s G(x*, t) of (4), relative to L |e0|."""
+        """s G(x*, t) of (4), relative to L abs(e0)."""
         P = self.params
         d = P.x2 - x_star
         e_star = self.inlet_strain(t - (x_star - P.x1) / P.c)[0]
@@ -358,7 +356,7 @@ def default_ramp_time(P: Params) -> float:
 
 
 def thin_parameter(P: Params) -> float:
-    """eta = (h/2)^2 max(b1/a, f*/(|e0| sqrt(a b2))): the relative O(h^2) deviation scale."""
+    """eta = (h/2)^2 max(b1/a, f*/(abs(e0) sqrt(a b2))): the relative O(h^2) deviation scale."""
     eta = P.b1 / P.a
     if P.friction == "coulomb" and P.e0 != 0.0:
         eta = max(eta, P.fstar / (abs(P.e0) * math.sqrt(P.a * P.b2)))

@@ -128,7 +128,7 @@ class Simulation:
         return self._measure()[0]
 
     def rate(self) -> float:
-        """Largest local rate, relative to c |e0| (per unit length for theta)."""
+        """Largest local rate, relative to c abs(e0) (per unit length for theta)."""
         return self._measure()[1]
 
     def _measure(self):

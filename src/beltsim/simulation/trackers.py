@@ -184,7 +184,7 @@ class HistoryTracker(Tracker):
 
 class SteadyStateTracker(Tracker):
     """Steady when, ``hold`` checks in a row after the ramp, both the largest local rate
-    (max |u_t| and L max |theta_t|, relative to c |e0|) and the change of the total
+    (max abs(u_t) and L max abs(theta_t), relative to c abs(e0)) and the change of the total
     friction over one window of simulated time (relative to its value) are below ``tol``.
     """
 

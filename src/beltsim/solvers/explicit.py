@@ -7,35 +7,17 @@ Each step is a Strang splitting of the semi-discrete model into two parts:
   vm = (v_a + v_b) / 2 solves (2/dt + d) vm + G vm = (2/dt) v_a, with G the
   gyroscopic operator over the lumped mass (lower bidiagonal, one pass in the
   direction of the flow for both fields), then v_b = 2 vm - v_a and u += dt vm. The
-  trapezoidal rule is A-stable, so G sets no step limit, damping or not (explicit, the
-  central G grows at any step and the upwind one needs damping in the rotation
-  equation);
+  trapezoidal rule is A-stable, so G sets no step limit, damping or not;
 * the kick at t_n: elastic, shear, load and friction forces of u_n, v += dt f / m.
   The half kicks of consecutive Strang steps merge into this one, so between steps
   the state is (u_n, v after the kick), and u_t(t_n) is the mean of the velocities
   before and after it (second order).
 
-Only the kick's stiffness terms are explicit: the step is limited by the waves
-(dt <= h / sqrt(B / rho) on a uniform grid; the old leapfrog needed
-h / (c + sqrt(b1 / rho))). Both parts vanish at rest, so the fixed point is the
-semi-discrete steady state of the implicit schemes.
-
-G is upwind, 2 rho c hbar_j (v_j - v_{j-1}) / h_{j-1}, as in the model the Newton
-schemes solve (physics.model), so all schemes share the semi-discretisation. Measured on
-the linearisation of the semi-discrete model at the paper slip steady state (1000
-elements graded 8, the default then): with the central term it is unstable, real parts
-up to +2.5/s with d = 39/s and +9/s with d = 0 (friction in the stick zone pumps the
-rotation modes), and a time-accurate scheme follows it and never settles (BDF2 at
-time_tol 1e-7 had not settled after 3 s on 300 elements; the default implicit run
-settles through BDF2's damping at its large steps). With the upwind term the slowest
-mode decays at 10/s with d = 39/s; with d = 0 it decays on coarse grids (4.8/s on 300
-elements), while on 1000 elements one mode still grows at +0.28/s, which a run
-reproduces (within 5% of the steady friction up to t_end). (These figures are of the
-first-order transport; with the three-point one the undamped run on 1000 elements still
-rings and grows, the same in this scheme and in BDF2 at time_tol 1e-7: total friction
-204 N peak to peak over 0.1-0.2 s, 249 N over 0.9-1.0 s, about +0.25/s, mean within 3 N
-of the steady 7124 N.) The central term, by a tridiagonal (Thomas) solve, was also
-stable by von Neumann but grew near its limit on bounded grids without damping.
+Only the kick's stiffness terms are explicit: the step is limited by the waves. Both
+parts vanish at rest, so the fixed point is the semi-discrete steady state of the
+implicit schemes. G is upwind, 2 rho c hbar_j (v_j - v_{j-1}) / h_{j-1}, as in the
+model the Newton schemes solve (physics.model), so all schemes share the
+semi-discretisation; why upwind: docs/theory/discretisation.md, "The gyroscopic term".
 
 Friction is implicit in each friction node's own velocity. Its slope f* / v_reg is
 enormous, so the velocity it sees must damp the friction relaxation (the mean of the
@@ -54,16 +36,9 @@ friction force is wf_j f* g, wf_j the contact part of its control volume. The
 corrections are dt times changes of increments: O(dt^2) where friction is smooth,
 zero at steady state. C_EST = 1/16 puts the roots of the stiff limit at -1/3 (a
 double root, the smallest reachable); ALPHA makes the stick-zone transport (upwind,
-explicit in u_n) stable at large Courant numbers r = c dt / h: in the stiff limit of
-the bottom fibre alone (no waves, no gyroscopic term) the three-point transport needs
-r < 0.13 without it, r < 1.5 with ALPHA = 0.25, r < 1.9 with 0.3 and r < 2.0 with
-ALPHA >= 0.5 (the two-point upwind transport of the first-order model: r < 0.26
-without it, any r with ALPHA = 0.25; the three-point symbol is twice as large at
-kh = pi). The full von Neumann analysis below (with the gyroscopic and wave terms)
-decides the step of each scene. The waves' limit keeps
-r = c / sqrt(B / rho) below 1 on the paper's data. delta_{j-1} and delta_{j-2} are
-known first in a sweep in the direction of the flow, so each node is one monotone
-scalar equation.
+explicit in u_n) stable at large Courant numbers c dt / h. delta_{j-1} and
+delta_{j-2} are known first in a sweep in the direction of the flow, so each node is
+one monotone scalar equation.
 
 The exact laws (numerics.friction_law = "exact") are the stiff limit of that scalar
 equation, solved by projection: the node sticks (its estimated slip velocity is 0) when
@@ -72,7 +47,7 @@ the ratio on the bound.
 
 The step is EXPLICIT_SAFETY of the limit found by a von Neumann analysis of this
 scheme (both fields, friction at all slopes with its transport) on the smallest
-element; a requested step above the limit is refused.
+element; a requested step above the limit is refused. See docs/theory/time-schemes.md.
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ from .ssn import Saddle, project, saddle_factor, saddle_substitute, saddle_syste
 OK, FAILED, NONFINITE = 0, 1, 2
 # How far above the tolerance a stalled Newton update may be and still count as
 # converged: 1e3 * 1e-9 = 1e-6, an order below the discretisation error of the finest
-# grid tried (1.4e-5 on 20,000 elements).
+# grids (docs/theory/discretisation.md, "Newton's method").
 ROUNDOFF_FLOOR = 1e3
 # Largest ratio of successive updates (the rate) with which the error an update leaves
 # is estimated as rate / (1 - rate) times the update: Newton stops when that is below
@@ -232,9 +232,9 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     lam), when the error it leaves is: rate / (1 - rate) times the update, the rate
     being the ratio of successive updates (below CONTRACTION), or when it has reached
     the round-off floor: below ROUNDOFF_FLOOR * tol and no longer halving. The floor
-    grows with the condition number of the Jacobian, ~ (L / h_min)^2: on 20,000
-    elements the update stalls near 1e-8 and a fixed 1e-9 failed every step. None of
-    these counts while a friction ratio is stuck at +-1 (:func:`release_stuck_ratios`).
+    grows with the condition number of the Jacobian, ~ (L / h_min)^2, and on very fine
+    grids lies above a fixed tol. None of these counts while a friction ratio is stuck
+    at +-1 (:func:`release_stuck_ratios`).
 
     On return, w holds the block LU of the Jacobian last factorised (block_factor)
     and the friction slopes it was assembled with (w.sgf), for the step's error
@@ -322,9 +322,8 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
     stick/slip state of every friction node is the one the last step was solved with.
     The ratios are not projected onto [-1, 1] between iterations: a stuck node whose
     update overshoots the bound must count as sliding at the next assembly, and clipped
-    to the bound it sat on the switch (lam + v_rel / v_aug = +-1 with v_rel ~ 0) and was
-    read as stuck or sliding by round-off (random scene 6 of seed 1, 11,558 elements, to
-    0.2 s: 11,839 Newton iterations and 181 steps cut, against 22,515 and 394).
+    to the bound it would sit on the switch (lam + v_rel / v_aug = +-1 with v_rel ~ 0)
+    and be read as stuck or sliding by round-off.
     On return, w holds the block LU of the 2x2 Jacobian with the stuck nodes' slope
     f_s AUGMENTATION / v_aug, the default regularisation's (a penalty standing in for
     their constraint), for the step's error estimate, as :func:`newton` leaves its own.

@@ -1,56 +1,25 @@
 """Resolved numerical settings: the scene's [numerics] with scene-dependent defaults.
 
-Defaults (all overridable in [numerics]):
+:func:`resolve` fills every key a scene leaves out; the keys, their rules and their
+defaults are listed in the user guide (docs/user-guide/scenes.md, "[numerics]"). The
+defaults are chosen as follows (the theory pages say why, the verification pages show
+the errors they give):
 
-* ``elements`` max(600, 10 L max(alpha, beta)): 600, or more where theta decays
-  over a shorter length than the paper's 17 mm (10 elements per decay length, as 600
-  give the paper's); ``grading`` 5 (smallest elements at x2 and at the analytic slip
-  start, where friction jumps to f*: x1 when the whole contact slides; largest 5x
-  bigger). Chosen for the second-order model so that the default paper slip run meets
-  its targets with a margin (steady errors on 600 elements, grading 5: total friction
-  9.2e-6, u 8.7e-6, theta 3.9e-5, slip start 4.2e-7 m, against 2e-5, 5e-5, 5e-4 and
-  2e-5 m) at 60% of the old 1000 elements' cost. Grading 4 gave 7.8e-6 but a
-  concentrated-force error of the stick scenes 1.2 to 2 times grading 5's; 8, 1.3e-5;
-* ``ramp_time`` 2 L / c: the surface speed goes smoothly from c to v (a number or a
-  sine; a table sets its own times, :mod:`beltsim.problem.drive`);
-* ``dt`` max(ramp_time, L / c) / 50;
-* ``t_end`` T + 400 L / c, T the end of the drive's changes (the ramp, the last row of
-  every table); a run that has not settled by then stops with converged = false;
-* ``regularisation`` (coulomb) v_reg = 1e-4 |v - c| r, v the final surface speed (the
-  largest |v(t) - c| of the profile when that is 0 or the drive is periodic) and
-  r = min(1, max(0.01, (N0 / N)^2)), N the grid's elements and N0 the default's: on the default
-  grid the creep velocity in stick zones is ~1e-4 of the imposed one and the layer
-  (b1 - rho c^2) v_reg / (c f*) that replaces the jump at x* is far below an
-  element. The regularisation's error is first order in v_reg (2e-6 of the total
-  friction on paper slip at 1e-4 |v - c|), so a fixed v_reg left a floor that finer
-  grids hit from 1000 elements on; shrunk with the grid as h^2 it stays the same
-  fraction of the grid's error and the errors fall at second order;
-* ``adhesion_layer`` (stick) delta = 1e-6 L r: perfect adhesion is the linear law
-  f = -kappa v_rel with kappa = (b1 - rho c^2) / (c delta), which spreads the
-  concentrated force over a layer of width delta upstream of x2;
-* ``friction_law`` "tanh" (coulomb), the adhesion layer (stick); "exact" for either:
-  the set-valued law without regularisation (Coulomb, or exact adhesion), solved by a
-  semi-smooth Newton (solvers.ssn) with the augmentation velocity v_aug = |v - c|;
-* ``acceleration`` (the pseudo-transient scheme only) 2 omega_1 with
-  omega_1 = pi (b1 - rho c^2) / (L sqrt(rho b1)), the lowest axial frequency of the
-  domain: a damping of u_t and theta_t on top of the scene's own, which changes the
-  path but not the steady state;
-* ``time_tol`` 6e-6: the relative local error per step of the time-accurate
-  implicit scheme; chosen so that the paper slip history (total friction at every
-  check, default grid) stays within 1e-3 of a converged one (against time_tol 1e-7,
-  600 elements: 8.7e-4 at 6e-6 in 2700 steps, 6.6e-4 at 4e-6, the old default, in
-  3183, 1.07e-3 at 8e-6; paper inertia 9.1e-4 at 6e-6);
-* ``steady_tol`` 1e-6: relative rates and relative change of the total friction
-  per window (one transit time L / c) that count as steady;
-* ``newton_tol`` 1e-9 (scaled max norm of the Newton update) and
-  ``newton_max_iterations`` 30 per implicit step;
-* ``max_work`` (the explicit scheme only) 2e10 node-steps: the most a run may need,
-  (t_end / dt) steps of every node, before it is refused (about 10 minutes at the
-  kernel's 3e7 node-steps per second).
+* the grid: ``DEFAULT_ELEMENTS`` elements, or ``ELEMENTS_PER_LAYER`` per decay length
+  of theta where that is shorter than the paper's, graded ``DEFAULT_GRADING`` towards
+  x2 and the expected slip start (docs/theory/discretisation.md, "The grid");
+* the regularisation (``regularisation``, ``adhesion_layer``) shrinks with the grid's
+  error on grids finer than the default, so its own first-order error stays a fixed
+  fraction of the grid's (docs/theory/friction.md);
+* ``time_tol`` keeps the paper slip history within 1e-3 of a converged one
+  (docs/theory/time-schemes.md);
+* ``max_work`` refuses, before it starts, an explicit run whose estimated work (steps
+  times nodes) exceeds it; the message quotes the estimate and points to the implicit
+  scheme.
 
 Every grid is first checked against the machine's available memory (MEMORY_PER_NODE
-bytes a node, measured at 2e6 elements: 460 implicit, 390 pseudo, 270 explicit, with a
-margin): an oversized grid is refused before anything is allocated.
+bytes a node, the largest a scheme needs at its peak, with a margin): an oversized grid
+is refused before anything is allocated.
 """
 
 from __future__ import annotations
@@ -70,10 +39,8 @@ from . import registry
 DEFAULT_ELEMENTS = 600
 DEFAULT_GRADING = 5.0
 # default elements per L / l_min, l_min the shortest decay length of theta (1/beta in
-# free segments, 1/alpha in stick): 10 resolves the paper's 17 mm layer as the 600
-# default elements do (thinner belts, paper data without inertia, steady: h = 0.01 m,
-# 2134 elements, theta errors 5.8e-5 (slip) and 2.3e-4 (perfect adhesion); h = 0.003 m,
-# 7112 elements, 3.7e-5 and 4.5e-4)
+# free segments, 1/alpha in stick): 10 resolves the paper's 17 mm layer as the default
+# elements do, and thinner layers as well
 ELEMENTS_PER_LAYER = 10.0
 DEFAULT_TIME_TOL = 6e-6
 MIN_MISMATCH = 1e-8  # smallest nonzero |v/c - 1| a run accepts
@@ -82,15 +49,16 @@ EXPLICIT_RATE = 3e7  # node-steps per second of the explicit kernel (bench), for
 MEMORY_PER_NODE = 600  # bytes a grid node costs a run at its peak
 MIN_REGULARISATION = 1e-12  # smallest regularisation velocity, relative to c
 DEFAULT_ADHESION_LAYER = 1e-6  # delta / L
-# Smallest factor on the default v_reg and delta as the grid is refined (10 times the
-# default elements): 1e-6 |v - c| and 1e-8 L were measured clean to 4000 elements, where
-# 5.6e-9 L (8000 elements) left the stick scenes' concentrated force at 4e-7, Newton's
-# round-off floor with so stiff a law
+# Smallest factor on the default v_reg and delta as the grid is refined (reached at 10
+# times the default elements): a stiffer adhesion law leaves the concentrated force at
+# Newton's round-off floor
 MIN_REFINE = 1e-2
 
 
 @dataclass(frozen=True)
 class Numerics:
+    """The numerical settings of a scene with every default resolved (:func:`resolve`)."""
+
     integrator: str
     elements: int
     grading: float
@@ -111,6 +79,7 @@ class Numerics:
 
     @property
     def law_code(self) -> int:
+        """The friction law's code as the kernels read it (``physics.friction.LAW_CODES``)."""
         return LAW_CODES[self.law]
 
 
@@ -225,12 +194,13 @@ def settle_time(scene: Scene, ramp_time: float) -> float:
 
 
 def default_elements(P: Params) -> int:
-    """1000, or more when the scene's boundary layers are thinner than the paper's."""
+    """DEFAULT_ELEMENTS, or more when the scene's boundary layers are thinner than the paper's."""
     alpha, beta = decay_rates(P)
     return max(DEFAULT_ELEMENTS, math.ceil(ELEMENTS_PER_LAYER * P.L * max(alpha, beta)))
 
 
 def build_grid(scene: Scene, num: Numerics) -> Grid:
+    """The scene's grid: ``num.elements`` graded towards x2 and the expected slip start."""
     P = scene.params
     return make_grid(P.L, P.x1, P.x2, num.elements, num.grading,
                      refine_at=expected_slip_start(scene))

@@ -6,14 +6,12 @@ complementarity equation lam = proj(lam + v_rel / v_aug). Its generalised Jacobi
 row at a node that sticks (lam + v_rel / v_aug inside [-1, 1]; always for adhesion) is
 that of v_rel / v_aug (the stick constraint: the ratio itself has no entry), at a
 node that slides that of lam - sign. The stick rows cannot be condensed into the
-(u, theta) rows node by node as the regularised laws' are (an augmented-Lagrangian
-update of the ratios condensed that way, tried on the paper slip scene with
-v_aug = 1e-4 |v - c| from the tanh steady state, diverged), so the system is solved
+(u, theta) rows node by node as the regularised laws' are, so the system is solved
 whole: per interior node the unknowns (u_j, theta_j, lam_j) (lam_j = 0, identity row,
 off the friction nodes), 3x3 blocks with the same band as the model's 2x2 Jacobian
 (two lower bands from the friction stencil, one upper), factorised by block LU with
 each 3x3 pivot inverted whole (the stick rows have a zero diagonal entry; the pivot
-block is regular where c sw_jj + inv_dt > 0).
+block is regular where c sw_jj + inv_dt > 0). See docs/theory/exact-friction.md.
 """
 
 from __future__ import annotations

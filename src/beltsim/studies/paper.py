@@ -45,6 +45,7 @@ def table1(sols=None) -> list[dict]:
 
 
 def format_table1(rows) -> str:
+    """Table 1 as text, in the paper's layout."""
     head = (f"{'Table 1. Total friction traction, N':<26s}\n"
             f"{'':<26s}{'Concentrated part':>20s}{'Distributed part':>20s}{'Total':>10s}\n"
             f"{'':<26s}{'or slipping part':>20s}{'or sticking part':>20s}{'':>10s}")

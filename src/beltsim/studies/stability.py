@@ -35,6 +35,8 @@ BOUNDS = {"total_friction": 5e-3, "u": 2e-2, "theta": 2e-2, "concentrated_force"
 
 
 class CellStatus(enum.StrEnum):
+    """How a cell of the stability matrix or the random study ended."""
+
     CONVERGED = "converged"
     BOUNDED = "bounded"  # a fixed span of simulated time: finite and bounded throughout
     OUT_OF_BOUNDS = "out of bounds"
@@ -53,7 +55,7 @@ ACCEPTED = (CellStatus.CONVERGED, CellStatus.BOUNDED, CellStatus.REFUSED,
             CellStatus.NOT_APPLICABLE, CellStatus.UNSTABLE)
 #: A growth rate counts as unstable above this fraction of max(|lambda|, c / L): growth
 #: of at least 1e-3 per radian of the mode's oscillation and per transit (far above
-#: the eigensolver's round-off, measured 1e-9 relative between dense and shift-invert).
+#: the eigensolver's round-off).
 GROWTH_MARGIN = 1e-3
 _RUN_STATUS = {RunStatus.FAILED: CellStatus.DIVERGED, RunStatus.REACHED_END:
                CellStatus.NOT_CONVERGED, RunStatus.INTERRUPTED: CellStatus.NOT_CONVERGED}
@@ -104,8 +106,8 @@ STABILITY_CASES = (
     Case("v < c (reversed forces)", "paper_slip", (("motion.surface_speed", 118.8),)),
     Case("short contact (x2 - x1 = 0.02 L)", "paper_slip",
          (("contact.start", 0.49), ("contact.end", 0.51))),
-    # at the paper's 39 1/s this geometry flutters (a 200 Hz slip-zone mode grows,
-    # README): damped above ~130 1/s it settles; at 39 1/s it runs a span
+    # at the paper's 39 1/s this geometry flutters (a slip-zone mode grows; the
+    # CHANGELOG has the eigenvalues): damped at 200 1/s it settles; at 39 1/s it runs a span
     Case("contact ends 0.02 L from the outlet (d = 200 1/s)", "paper_slip",
          (*_OUTLET, ("physics.damping", 200.0))),
     Case("contact ends 0.02 L from the outlet, d = 39 1/s: flutter", "paper_slip", _OUTLET,

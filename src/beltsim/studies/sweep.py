@@ -62,6 +62,7 @@ def run_point(scene_dict: dict, key: str, value, keep_theta=False) -> dict:
 
 
 def make_executor(workers: int | None = None, scheduler: str | None = None) -> Executor:
+    """A pool of ``workers`` processes (default one per core), or a Dask cluster's client."""
     if scheduler:
         try:
             from distributed import Client
