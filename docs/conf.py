@@ -55,7 +55,10 @@ numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
 # every object of the API reference has a docstring with a summary line
 numpydoc_validation_checks = {"GL08", "SS01"}
-numpydoc_validation_exclude = {r"\.__init__$", r"\.__repr__$", r"\._"}
+# the built-in trackers' hooks inherit their docstrings from beltsim.Tracker
+numpydoc_validation_exclude = {r"\.__init__$", r"\.__repr__$", r"\._",
+                               r"trackers\.\w+Tracker\.(initialize|handle|finalize|state|"
+                               r"restore)$", r"trackers\.DivergenceGuard\.handle$"}
 
 # -- examples gallery ---------------------------------------------------------
 sphinx_gallery_conf = {
