@@ -4,10 +4,13 @@ The README's test command sets NUMBA_BOUNDSCHECK=1, which compiles the kernels w
 bounds checks. numba's on-disk cache does not key its entries on that flag, so kernels
 cached by a bounds-checked test run were loaded by later ordinary runs in the same tree,
 which then ran at half speed: the default paper slip run took 0.89 s after a test run
-against 0.43-0.47 s from a clean cache (measured). A bounds-checked session therefore
-keeps its kernels in a cache directory of its own.
+against 0.43-0.47 s from a clean cache. A bounds-checked session therefore keeps its
+kernels in a cache directory of its own, named after the sources' contents: numba's cache
+checks only the timestamp of a kernel's own file, so a kernel cached before a function it
+calls in another file changed would be loaded with the old callee.
 """
 
+import hashlib
 import os
 import sys
 import tempfile
@@ -19,8 +22,14 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 if os.environ.get("NUMBA_BOUNDSCHECK", "0") not in ("", "0"):
-    os.environ.setdefault("NUMBA_CACHE_DIR",
-                          os.path.join(tempfile.gettempdir(), "beltsim-numba-boundscheck"))
+    from importlib.util import find_spec
+
+    # found without importing beltsim, which imports numba before the variable is set
+    _package = Path(find_spec("beltsim").submodule_search_locations[0])
+    _sources = sorted(_package.rglob("*.py"))
+    _digest = hashlib.sha256(b"".join(p.read_bytes() for p in _sources)).hexdigest()[:16]
+    os.environ.setdefault("NUMBA_CACHE_DIR", os.path.join(
+        tempfile.gettempdir(), f"beltsim-numba-boundscheck-{_digest}"))
 
 
 #: The markers of pyproject.toml's [tool.pytest.ini_options]; a test carries one at least.
