@@ -104,7 +104,9 @@ def _figure(page: Page, results: dict) -> None:
                       ha="right", fontsize=8)
         ax.set_title(f"{name} ({ran[0]['elements']} elements)" if ran else name, fontsize=10)
         ax.grid(True, axis="y", which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+    # one legend for all panels, from the panel with the most schemes
+    widest = max(np.atleast_1d(axes), key=lambda a: len(a.get_legend_handles_labels()[1]))
+    fig.legend(*widest.get_legend_handles_labels(), loc="outside right upper", fontsize=8)
     np.atleast_1d(axes)[0].set_ylabel("error against the exact steady state")
     page.figure(fig, "errors", "Errors of the end states against the exact steady "
                                "solutions, per scheme (relative; the slip start in metres)")

@@ -111,6 +111,15 @@ def wrap(text: str) -> str:
                          break_on_hyphens=False)
 
 
+def decorate(ax, xlabel: str, ylabel: str, title: str) -> None:
+    """Labels, a small title and legend, and a light grid (both ticks on log axes)."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=7)
+    ax.grid(True, which="both", alpha=0.3)
+
+
 def md_table(header, rows) -> str:
     """A Markdown table; ``|`` inside a cell is escaped."""
     def cell(v):

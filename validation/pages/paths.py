@@ -11,7 +11,7 @@ from beltsim.problem.transient import thin_belt
 from beltsim.simulation.controller import Simulation, run
 from beltsim.solvers.settings import DEFAULT_TIME_TOL
 
-from .kit import FAILED, Page, fmt, num
+from .kit import FAILED, Page, decorate, fmt, num
 
 TITLE = "Transient paths"
 SNAP = 2.0**-11  # s: the thin belt's check interval (binary, so fixed steps land on it)
@@ -140,20 +140,12 @@ def _thin_figures(page: Page, ladder, errors, shown) -> None:
             label="exact (adhesion)")
     ax.plot(stick.history["t"][::step] * 1e3, stick.history["total_friction"][::step], "s",
             ms=3, mfc="none", color="tab:green", label="implicit (adhesion)")
-    ax.set_xlabel("t [ms]")
-    ax.set_ylabel("total friction [N]")
-    ax.set_title("Start-up of the thin belt", fontsize=10)
-    ax.legend(fontsize=7)
-    ax.grid(True, alpha=0.3)
+    decorate(ax, "t [ms]", "total friction [N]", "Start-up of the thin belt")
     ax = axes[1]
     ax.plot(t * 1e3, h["slip_start"], "-", color="k", label="exact x*(t)")
     ax.plot(res.history["t"][::step] * 1e3, res.history["slip_start"][::step], "o", ms=3.5,
             mfc="none", color="tab:blue", label="implicit")
-    ax.set_xlabel("t [ms]")
-    ax.set_ylabel("slip start x* [m]")
-    ax.set_title("The slip front opens from x2 (Coulomb)", fontsize=10)
-    ax.legend(fontsize=7)
-    ax.grid(True, alpha=0.3)
+    decorate(ax, "t [ms]", "slip start x* [m]", "The slip front opens from x2 (Coulomb)")
     ax = axes[2]
     styles = {"implicit": ("o", "-"), "pseudo": ("s", "--")}
     colors = {"coulomb": "tab:blue", "stick": "tab:green"}
@@ -165,11 +157,8 @@ def _thin_figures(page: Page, ladder, errors, shown) -> None:
             ax.loglog(n, e[0] * (n[0] / n) ** EXPECTED[scheme], ":", color="0.5", lw=1)
     ax.set_xticks(n, [str(int(v)) for v in n])
     ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.set_xlabel("elements (the step halves with the element)")
-    ax.set_ylabel("history error (relative)")
-    ax.set_title("Errors; dotted: orders 1 and 2", fontsize=10)
-    ax.legend(fontsize=7)
-    ax.grid(True, which="both", alpha=0.3)
+    decorate(ax, "elements (the step halves with the element)", "history error (relative)",
+             "Errors; dotted: orders 1 and 2")
     page.figure(fig, "thin_belt", "The thin belt's start-up: exact histories (lines) and "
                                   "simulated (markers), and the history error as the grid "
                                   "and the step shrink together")
@@ -259,12 +248,8 @@ def tolerance_section(page: Page, quick: bool) -> None:
     for label, (t, d) in curves.items():
         ax.semilogy(t, np.maximum(d, 1e-12), label=label, lw=1)
     ax.axhline(1e-3, ls="--", color="k", lw=0.8, label="1e-3")
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("|F - F_ref| / |F_steady|")
-    ax.set_title(f"paper_slip, {where}: total friction against the time_tol "
-                 f"{num(cfg['reference'])} run", fontsize=10)
-    ax.legend(fontsize=7)
-    ax.grid(True, which="both", alpha=0.3)
+    decorate(ax, "t [s]", "|F - F_ref| / |F_steady|", f"paper_slip, {where}: total "
+             f"friction against the time_tol {num(cfg['reference'])} run")
     page.figure(fig, "time_tol", "Path difference of the total friction from the reference "
                                  "run, check by check")
 
