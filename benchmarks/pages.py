@@ -204,6 +204,14 @@ def build(page: Page, quick: bool, cold: bool = True) -> None:
               f"shortest of {repeat}.")
     rows = _grid_section(page, ladder, repeat)
     _figure(page, rows)
+    same = [res["ours_wall_time"], lab["ours_wall_time"]] + [
+        r["wall"] for r in rows if r["elements"] == res["elements"]]
+    if len(same) > 1:
+        page.para(f"The default run on {res['elements']} elements is timed {len(same)} times "
+                  f"on this page, once by each command: {min(same):.3g} to {max(same):.3g} "
+                  f"s. Their spread is the machine's, not beltsim's.")
+    page.para(f"Load average at the end of the run: {os.getloadavg()[0]:.2f} (at the start: "
+              f"see the top of the page); on this machine {os.cpu_count()} cores.")
 
 
 def main(argv=None) -> int:
