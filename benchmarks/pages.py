@@ -1,0 +1,262 @@
+"""The performance page of the documentation, from fresh runs.
+
+``python -m benchmarks.pages [--quick] [--out DIR]`` times beltsim on the paper slip
+scene and writes ``timings.md`` with its figure and ``index.md`` into DIR (default
+``docs/performance``): the default run and the steady scheme, the explicit kernel's
+node-steps per second and a cold start (:func:`beltsim.studies.bench.bench`); the
+generic scipy peers and the numpy port of the default scheme (:func:`benchmarks.bench.bench`);
+the compile time and the cache load time of the kernels, each in a fresh process; and the
+default run across grids. Every wall time is the shortest of ``--repeat`` runs with the
+kernels loaded, compilation apart. ``--quick`` does the same on a tiny grid, once.
+
+Exit status: 0 when every beltsim run reached its steady state; 1 when one did not or a
+measurement failed (the page says which); 2 on a missing input or a bad option.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from validation.pages.kit import (
+    ROOT,
+    Page,
+    command_line,
+    commit,
+    describe_machine,
+    fmt,
+    log,
+    machine_facts,
+    num,
+    write_index,
+)
+
+DEFAULT_OUT = ROOT / "docs" / "performance"
+SCENE = "paper_slip"
+#: (grid or None for the default, repeats, transient peers' wall cap in s, grid ladder)
+MODES = {False: (None, 3, 600.0, (250, 600, 1000, 2000)), True: (40, 1, 60.0, (20, 40, 60))}
+TITLE = "Timings"
+INDEX_INTRO = (
+    "How fast beltsim runs, measured by `python -m benchmarks.pages` on the machine its "
+    "page names: the default run of the paper slip scene, the steady scheme, the explicit "
+    "kernel, compilation and a cold start, against generic scipy peers and a numpy port "
+    "of the default scheme. `python -m benchmarks.pages --quick` does the same on a tiny "
+    "grid (CI runs it).")
+
+_KERNEL_LOAD = """
+import json, sys, time
+from beltsim.problem.scene import Scene
+from beltsim.simulation.controller import Simulation
+sim = Simulation(Scene.loads(sys.stdin.read()))
+print(json.dumps({"seconds": sim.warm_up()}))
+"""
+
+
+def kernel_load_time(scene, empty_cache: bool) -> float:
+    """Seconds to compile (``empty_cache``) or to load from numba's cache the scene's
+    scheme kernels, in a fresh process (the interpreter's start and imports left out)."""
+    env = dict(os.environ)
+    with tempfile.TemporaryDirectory() as cache:
+        if empty_cache:
+            env["NUMBA_CACHE_DIR"] = cache
+        proc = subprocess.run([sys.executable, "-c", _KERNEL_LOAD], input=scene.to_toml(),
+                              env=env, capture_output=True, text=True, timeout=1200,
+                              check=False)
+    if proc.returncode != 0:
+        raise RuntimeError(f"kernel load in a fresh process failed: {proc.stderr.strip()}")
+    return float(json.loads(proc.stdout.strip().splitlines()[-1])["seconds"])
+
+
+def _ours_table(page: Page, res: dict, compile_s: float, load_s: float) -> None:
+    page.table(["quantity", "value"], [
+        ["elements", str(res["elements"])],
+        ["default run (implicit), wall to steady state [s]", fmt(res["ours_wall_time"], ".4g")],
+        ["default run: steps", str(res["ours_steps"])],
+        ["default run: error of the total friction", fmt(res["ours_error"], ".2e")],
+        ["steady scheme, wall [s]", fmt(res["ours_steady_wall_time"], ".4g")],
+        ["steady scheme: error of the total friction", fmt(res["ours_steady_error"], ".2e")],
+        ["explicit kernel [node-steps/s]", fmt(res["explicit_node_steps_per_s"], ".3g")],
+        ["compile the default scheme's kernels, empty cache [s]",
+         fmt(compile_s, ".3g") if compile_s is not None else "not measured"],
+        ["load them from numba's cache [s]", fmt(load_s, ".3g")],
+        [("cold start: `beltsim run` in a fresh process with an empty cache, to steady "
+          "state [s]"), fmt(res["cold_start_time"], ".3g") if res["cold_start_time"] is not None
+         else "not measured"]])
+
+
+def _peers_table(page: Page, lab: dict) -> None:
+    rows = [["beltsim, implicit (default)", fmt(lab["ours_wall_time"], ".4g"),
+             fmt(lab["ours_error"], ".2e"), str(lab["ours_steps"]), "", "yes", ""],
+            ["beltsim, steady scheme", fmt(lab["ours_steady_wall_time"], ".4g"),
+             fmt(lab["ours_steady_error"], ".2e"), "", "", "yes", ""]]
+    port = lab.get("port")
+    if port:
+        if not port["converged"] and not str(port["reason"]).startswith("not applicable"):
+            page.fail(f"numpy port: {port['reason']}")
+        rows.append([port["method"], fmt(port["wall_time"], ".4g"), fmt(port["error"], ".2e"),
+                     str(port.get("steps", "")), "", "yes" if port["converged"] else "no",
+                     fmt(lab.get("kernel_speedup"), ".3g")])
+    for key, p in (lab.get("peers") or {}).items():
+        speed = None
+        if p["converged"] and p["wall_time"]:
+            base = lab["ours_steady_wall_time"] if key == "newton" else lab["ours_wall_time"]
+            speed = p["wall_time"] / base
+        rows.append([p["method"], fmt(p["wall_time"], ".4g"), fmt(p["error"], ".2e"),
+                     str(p.get("steps", "")),
+                     num(p["tolerance"]) if p.get("tolerance") is not None else "",
+                     "yes" if p["converged"] else f"no: {p['reason']}", fmt(speed, ".3g")])
+    page.table(["method", "wall [s]", "error of the total friction", "steps",
+                "rtol (Newton: tol)", "reached beltsim's steady state",
+                "its wall over beltsim's"], rows)
+
+
+def _grid_section(page: Page, ladder, repeat: int) -> list[dict]:
+    from beltsim.problem.scene import shipped_scene
+    from beltsim.studies.bench import run_ours
+
+    rows = []
+    for n in ladder:
+        out, res, steady = run_ours(shipped_scene(SCENE, [f"numerics.elements={n}"]),
+                                    repeat, log=lambda *_: None)
+        if not (res.converged and steady.converged):
+            page.fail(f"{n} elements: {res.reason or steady.reason}")
+        rows.append({"elements": n, "wall": out["ours_wall_time"], "steps": out["ours_steps"],
+                     "newton": res.newton_iterations, "error": out["ours_error"],
+                     "steady": out["ours_steady_wall_time"],
+                     "steady_error": out["ours_steady_error"]})
+    page.table(["elements", "default run, wall [s]", "steps", "Newton iterations",
+                "error", "steady scheme, wall [s]", "error"],
+               [[str(r["elements"]), fmt(r["wall"], ".4g"), str(r["steps"]), str(r["newton"]),
+                 fmt(r["error"], ".2e"), fmt(r["steady"], ".3g"), fmt(r["steady_error"], ".2e")]
+                for r in rows])
+    return rows
+
+
+def _figure(page: Page, rows) -> None:
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), constrained_layout=True)
+    for key, label, style in (("wall", "default run (implicit)", "o-"),
+                              ("steady", "steady scheme", "^-")):
+        ax.loglog([r[key] for r in rows], [r["error" if key == "wall" else "steady_error"]
+                                           for r in rows], style, label=label)
+        for r in rows:
+            ax.annotate(str(r["elements"]), (r[key], r["error" if key == "wall"
+                                                      else "steady_error"]),
+                        textcoords="offset points", xytext=(4, 4), fontsize=7)
+    ax.set_xlabel("wall time [s] (shortest of the repeats, compilation excluded)")
+    ax.set_ylabel("relative error of the total friction")
+    ax.set_title(f"{SCENE}: error against wall time (labels: elements)", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    page.figure(fig, "grids", f"{SCENE}: error of the total friction against wall time, "
+                              f"default run and steady scheme, across grids")
+
+
+def build(page: Page, quick: bool, cold: bool = True) -> None:
+    from beltsim.problem.scene import shipped_scene
+    from beltsim.studies import bench as ours_bench
+
+    from . import bench as lab_bench
+
+    elements, repeat, cap, ladder = MODES[quick]
+    scene = shipped_scene(SCENE, [f"numerics.elements={elements}"] if elements else [])
+    grid = f"{elements} elements" if elements else "the default grid"
+    page.para(
+        f"beltsim on the paper slip scene (`{SCENE}`, {grid}). Wall times are the shortest "
+        f"of {repeat} {'run' if repeat == 1 else 'runs'} in one process with the numba "
+        f"kernels loaded; compiling and loading the kernels are measured apart, each in a "
+        f"fresh process. The machine is shared (its load at the start is given above), so "
+        f"the shortest of the repeats is the figure to read.")
+    page.heading("beltsim")
+    el = f" --elements {elements}" if elements else ""
+    page.para(f"`beltsim bench{el} --repeat {repeat}{'' if cold else ' --no-cold'}`: the "
+              f"default run from rest to steady state, the steady scheme, the explicit "
+              f"kernel alone in a settled state, and a cold start.")
+    compile_s = kernel_load_time(scene, empty_cache=True) if cold else None
+    load_s = kernel_load_time(scene, empty_cache=False)
+    res = ours_bench.bench(scene, cold=cold, repeat=repeat, log=log)
+    if not cold:
+        page.para("Run with `--no-cold`: the compile time and the cold start were not "
+                  "measured.")
+    if not res["ours_converged"]:
+        page.fail("the default run did not reach its steady state")
+    _ours_table(page, res, compile_s, load_s)
+    page.heading("Against generic peers and a numpy port")
+    page.para(
+        f"`python -m benchmarks.bench {SCENE}{el} --repeat {repeat} --peer-cap {cap:g}`: "
+        f"what a skilled scipy user would write instead, on the same grid and the same "
+        f"semi-discretisation: `solve_ivp`'s Radau and BDF with the analytic sparse "
+        f"Jacobian from rest to the run's steady test (a run is capped at {cap:g} s), and a "
+        f"sparse Newton iteration on the steady equations; and beltsim's own implicit "
+        f"scheme ported to numpy and scipy.sparse, taking the same steps, whose wall time "
+        f"over beltsim's is what the compiled kernels buy. A peer counts only if it "
+        f"reaches beltsim's steady state (total friction within 1e-5).")
+    lab = lab_bench.bench(scene, peer=True, port_run=True, repeat=repeat, peer_cap=cap, log=log)
+    _peers_table(page, lab)
+    page.heading("Across grids")
+    page.para(f"The default run and the steady scheme on {', '.join(map(str, ladder))} "
+              f"elements (`beltsim bench --elements N --repeat {repeat}`), each the "
+              f"shortest of {repeat}.")
+    rows = _grid_section(page, ladder, repeat)
+    _figure(page, rows)
+    same = [res["ours_wall_time"], lab["ours_wall_time"]] + [
+        r["wall"] for r in rows if r["elements"] == res["elements"]]
+    if len(same) > 1:
+        page.para(f"The default run on {res['elements']} elements is timed {len(same)} times "
+                  f"on this page, once by each command: {min(same):.3g} to {max(same):.3g} "
+                  f"s. Their spread is the machine's, not beltsim's.")
+    page.para(f"Load average at the end of the run: {os.getloadavg()[0]:.2f} (at the start: "
+              f"see the top of the page); on this machine {os.cpu_count()} cores.")
+
+
+def main(argv=None) -> int:
+    from beltsim.cli import OneLineParser
+    from beltsim.errors import MissingInputError
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = OneLineParser(prog="python -m benchmarks.pages",
+                           description="Write the performance page from fresh runs.")
+    parser.add_argument("--quick", action="store_true", help="a tiny grid, once (for CI)")
+    parser.add_argument("--out", type=Path, default=DEFAULT_OUT,
+                        help="output directory (default docs/performance)")
+    parser.add_argument("--no-cold", action="store_true",
+                        help="skip the measurements with an empty numba cache (compile "
+                             "time, cold start)")
+    args = parser.parse_args(argv)
+
+    import matplotlib
+    matplotlib.use("Agg")  # a script's figures go to files: no display
+
+    command = command_line("benchmarks.pages", argv)
+    sha = commit()
+    page = Page("timings", TITLE, command, sha, args.out, describe_machine(machine_facts()))
+    start = time.perf_counter()
+    status = 0
+    try:
+        build(page, args.quick, cold=not args.no_cold)
+    except MissingInputError as exc:
+        page.abort(f"missing input: {exc}", missing_input=True)
+    except Exception as exc:  # noqa: BLE001  a failed measurement is reported, not hidden
+        page.abort(f"{type(exc).__name__}: {exc}")
+    path = page.write()
+    if page.aborted is not None:
+        log(f"timings: FAILED ({page.aborted})")
+        status = 2 if page.missing_input else 1
+    elif page.failures:
+        for f in page.failures:
+            log(f"  failed: {f}")
+        status = 1
+    index = write_index(args.out, "Performance", INDEX_INTRO, ["timings"], command, sha)
+    log(f"wrote {path} and {index} in {time.perf_counter() - start:.0f} s, exit status "
+        f"{status}")
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())

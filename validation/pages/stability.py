@@ -1,0 +1,131 @@
+"""Page: the stability matrix (stiff and extreme scenes by every scheme) and a
+random-scene campaign."""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+
+from beltsim import solvers
+from beltsim.studies.stability import (
+    ACCEPTED,
+    BOUNDS,
+    DISCRETE_BOUNDS,
+    STABILITY_CASES,
+    CellStatus,
+    stability_markdown,
+    stability_matrix,
+)
+from validation.random_scenes import SKIPPED, failed, random_markdown, random_study
+
+from .kit import Page, num
+
+TITLE = "Stability matrix and random scenes"
+#: the coarse matrix of --quick: every case but those about the grid, on this grid
+QUICK_ELEMENTS = 60
+#: (scenes, seed, elements or None for each scene's default, max wall s) of the campaign
+RANDOM = {False: (40, 1, None, 900.0), True: (3, 1, None, 120.0)}
+
+
+def _status(row) -> str:
+    return getattr(row["status"], "value", row["status"])
+
+
+def matrix_section(page: Page, quick: bool) -> None:
+    cases = STABILITY_CASES
+    extra = []
+    if quick:
+        cases = tuple(c for c in cases if not c.sets_grid)
+        extra = [("numerics.elements", QUICK_ELEMENTS)]
+    command = "beltsim stability" + (f" --elements {QUICK_ELEMENTS}" if quick else "")
+    page.heading("The stability matrix")
+    page.para(
+        f"`{command}`: {len(cases)} stiff and extreme scenes, each derived from a paper "
+        f"scene, by every registered scheme ({', '.join(solvers.names())}). A cell ends in "
+        f"one status: *converged* (steady, within the transient simulator's acceptance "
+        f"bounds, " + ", ".join(f"{k} {b:g}" for k, b in BOUNDS.items()) + "), *bounded* "
+        "(a case run over a fixed span, or a stable but slowly settling one: finite and "
+        "bounded throughout), *refused* (a rule of the scene or its numerics, before "
+        "anything runs), *not applicable*, *unstable steady state* (the time-accurate run "
+        "did not settle and the model linearised about its steady state has a growing "
+        "mode), or a failure: *out of bounds*, *not converged*, *diverged*.")
+    if quick:
+        page.para(
+            f"This is the coarse matrix of `--quick`: every case on {QUICK_ELEMENTS} "
+            f"elements (the case about a very fine grid left out). The acceptance bounds "
+            f"are set for each scene's default grid, so a coarse cell is judged against "
+            f"the steady scheme's state on the same grid instead, within "
+            + ", ".join(f"{k} {b:g}" for k, b in DISCRETE_BOUNDS.items())
+            + ": each scheme must reach its grid's steady state.")
+    start = time.perf_counter()
+    rows = stability_matrix(cases, extra=extra, discrete=quick)
+    wall = time.perf_counter() - start
+    accepted = ACCEPTED
+    for r in rows:
+        if r["status"] not in accepted:
+            page.fail(f"stability matrix, {r['case']}, {r['scheme']}: {_status(r)} "
+                      f"({r['reason']})")
+    schemes = list(dict.fromkeys(r["scheme"] for r in rows))
+    statuses = [s.value for s in CellStatus if any(r["status"] is s for r in rows)]
+    tally = Counter((r["scheme"], _status(r)) for r in rows)
+    page.para(f"{len(rows)} cells in {wall:.0f} s of wall time; cells by scheme and status:")
+    page.table(["scheme", *statuses, "failed"],
+               [[s, *(str(tally[s, st]) for st in statuses),
+                 str(sum(1 for r in rows if r["scheme"] == s and r["status"] not in accepted))]
+                for s in schemes])
+    page.para("Status of every cell:")
+    by_case = {}
+    for r in rows:
+        cell = _status(r)
+        if r["status"] not in accepted:
+            cell = f"**{cell}**"
+        by_case.setdefault(r["case"], {})[r["scheme"]] = cell
+    page.table(["case", *schemes], [[case, *(cells.get(s, "") for s in schemes)]
+                                    for case, cells in by_case.items()])
+    page.para("Every cell in detail (errors against "
+              + ("the steady scheme's state on the same grid" if quick else
+                 "the exact steady solution of the case") + "; the slip start in metres):")
+    page.raw(stability_markdown(rows))
+
+
+def random_section(page: Page, quick: bool) -> None:
+    n, seed, elements, max_wall = RANDOM[quick]
+    extra = [("numerics.elements", elements)] if elements else []
+    command = (f"python -m validation.random_scenes {n} --seed {seed}"
+               + (f" --elements {elements}" if elements else "")
+               + f" --max-wall {num(max_wall)}")
+    page.heading("Random scenes")
+    page.para(
+        f"`{command}`: {n} valid scenes drawn across the whole parameter space (geometry, "
+        f"materials, speeds up to 0.95 of the lower critical speed, mismatch, friction, "
+        f"inertia and damping; scene i of seed S is always the same scene), each by every "
+        f"applicable scheme on its default grid, judged by the stability matrix's rules "
+        f"(the slip start's bound scaled to the grid). Cells not started within the wall "
+        f"budget are reported as skipped, not as passed.")
+    start = time.perf_counter()
+    rows = random_study(n, seed, extra=extra, max_wall=max_wall)
+    wall = time.perf_counter() - start
+    for r in rows:
+        if failed(r):
+            page.fail(f"random scene {r['index']} (seed {seed}), {r['scheme']}: "
+                      f"{r['status']} ({r['reason']})")
+    skipped = sum(r["status"] == SKIPPED for r in rows)
+    text = random_markdown(rows, seed, n, wall, extra)
+    # its title becomes a subsection of this page
+    lines = text.splitlines()
+    if lines and lines[0].startswith("# "):
+        lines[0] = "###" + lines[0][1:]
+    page.raw("\n".join(lines))
+    if skipped:
+        page.para(f"{skipped} cells were skipped when the wall budget ran out.")
+
+
+def build(page: Page, quick: bool) -> None:
+    page.para(
+        "Robustness, not accuracy: each scheme on scenes chosen to break it (stiff "
+        "friction, near-critical speeds, short contacts, undamped belts, extreme Poisson "
+        "ratios) and on random scenes. A scheme passes a cell when it delivers the "
+        "steady state within the bounds or says why it cannot; it fails when it runs and "
+        "does not deliver.")
+    matrix_section(page, quick)
+    random_section(page, quick)
