@@ -29,7 +29,7 @@ class RunResult:
     """A run's outcome: how it ended, its final state, its history.
 
     The final state reads as arrays over the grid (:attr:`x`, :attr:`fields`), the
-    checks as arrays over time (:attr:`history`), the numbers the analytic solution
+    checks as arrays over time (``history``), the numbers the analytic solution
     also gives in :meth:`summary`, and the errors against it in :meth:`errors`.
 
     Attributes
