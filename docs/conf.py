@@ -55,10 +55,13 @@ numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
 # every object of the API reference has a docstring with a summary line
 numpydoc_validation_checks = {"GL08", "SS01"}
-# the built-in trackers' hooks inherit their docstrings from beltsim.Tracker
+# the built-in trackers' hooks inherit their docstrings from beltsim.Tracker, the schemes'
+# from solvers.base.Scheme (autodoc shows the inherited one; numpydoc validates their own)
 numpydoc_validation_exclude = {r"\.__init__$", r"\.__repr__$", r"\._",
                                r"trackers\.\w+Tracker\.(initialize|handle|finalize|state|"
-                               r"restore)$", r"trackers\.DivergenceGuard\.handle$"}
+                               r"restore)$", r"trackers\.DivergenceGuard\.handle$",
+                               r"solvers\.\w+\.\w+Scheme\.(advance|solve|dt|statistics|"
+                               r"checkpoint|restore)$"}
 
 # -- examples gallery ---------------------------------------------------------
 sphinx_gallery_conf = {

@@ -5,7 +5,8 @@ A start-up, from rest to steady state
 The surface speeds up smoothly from the belt speed c to v over the ramp time; the
 friction drags the contact along, a slip zone opens at x2 and grows upstream, and the
 free spans ring until the damping settles them. ``result.history`` holds the friction
-totals at every check of the run as arrays.
+totals at every check of the run as arrays, and :func:`beltsim.plot_history` draws them
+on the axes it is given.
 """
 
 import matplotlib.pyplot as plt
@@ -14,27 +15,20 @@ import beltsim
 
 slip = beltsim.run(beltsim.paper_scene("slip"))
 stick = beltsim.run(beltsim.paper_scene("inertia"))
-print(f"paper slip: steady at t = {slip.simulated_time:.3f} s; "
-      f"paper inertia: steady at t = {stick.simulated_time:.3f} s")
+for name, res in (("paper slip", slip), ("paper inertia", stick)):
+    h = res.history
+    print(f"{name}: steady at t = {h['t'][-1]:.3f} s after {len(h['t'])} checks, "
+          f"total friction {h['total_friction'][-1]:.1f} N")
 
 # %%
-# The total friction of both scenes against its exact steady value, and the slip
-# start of the Coulomb scene against the exact steady x*.
+# Left, stick and slip: the total friction with its stick and slip parts, and the slip
+# start. Right, perfect adhesion: the total friction and the concentrated force at x2.
+# The exact steady values are dashed.
 
-fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True, constrained_layout=True)
-for res, color, name in ((slip, "tab:red", "stick and slip"),
-                         (stick, "tab:blue", "perfect adhesion")):
-    h = res.history
-    ax1.plot(h["t"], h["total_friction"], color=color, lw=1.2, label=name)
-    ax1.axhline(res.reference.total_friction, color=color, ls="--", lw=0.8)
-ax1.set_ylabel("total friction [N]")
-ax1.legend()
-ax1.grid(alpha=0.3)
-h = slip.history
-ax2.plot(h["t"], h["slip_start"], color="tab:red", lw=1.2, label="simulated")
-ax2.axhline(slip.reference.x_star, color="tab:red", ls="--", lw=0.8, label="exact steady")
-ax2.set_ylabel("slip start x* [m]")
-ax2.set_xlabel("t [s]")
-ax2.legend()
-ax2.grid(alpha=0.3)
+fig, axes = plt.subplots(2, 2, figsize=(10, 6), sharex=True, layout="constrained")
+beltsim.plot_history(slip, keys=("total_friction", "slip_start"), ax=axes[:, 0])
+beltsim.plot_history(stick, keys=("total_friction", "concentrated_force"), ax=axes[:, 1])
+axes[0, 0].set_title("stick and slip (paper_slip)", fontsize=10)
+axes[0, 1].set_title("perfect adhesion (paper_inertia)", fontsize=10)
+axes[0, 0].set_xlim(0.0, 0.15)
 plt.show()

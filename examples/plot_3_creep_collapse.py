@@ -13,12 +13,12 @@ import numpy as np
 
 import beltsim
 
-base = beltsim.paper_scene("slip", ["numerics.integrator=steady"])
+base = beltsim.paper_scene("slip", [("numerics.integrator", "steady")])
 x2 = base.params.x2
 limits = np.geomspace(5e4, 5e6, 7)
 simulated, exact = [], []
 for fstar in limits:
-    scene = base.with_overrides([f"contact.max_friction={fstar}"])
+    scene = base.with_overrides([("contact.max_friction", fstar)])
     res = beltsim.run(scene)
     simulated.append((x2 - res.solution.slip_start, res.solution.total_friction))
     exact.append((x2 - res.reference.x_star, res.reference.total_friction))

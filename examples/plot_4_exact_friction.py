@@ -14,13 +14,12 @@ import numpy as np
 
 import beltsim
 
-scene = beltsim.paper_scene("slip", ["numerics.integrator=steady"])
-exact_law = scene.with_overrides(['numerics.friction_law="exact"'])
+scene = beltsim.paper_scene("slip", [("numerics.integrator", "steady")])
+exact_law = scene.with_overrides([("numerics.friction_law", "exact")])
 res = beltsim.run(exact_law)
-sol = res.solution
 fstar = scene.params.fstar
-ratio = sol.fields()["friction"] / fstar
-on = (sol.x >= scene.params.x1) & (sol.x <= scene.params.x2)
+ratio = res.fields["friction"] / fstar
+on = (res.x >= scene.params.x1) & (res.x <= scene.params.x2)
 print(f"largest |ratio| on the contact: {np.abs(ratio[on]).max():.15f}")
 
 # %%
@@ -30,11 +29,11 @@ print(f"largest |ratio| on the contact: {np.abs(ratio[on]).max():.15f}")
 # half sliding.
 
 x_exact, f_exact = res.reference.sample(2001)
-tanh = beltsim.run(scene).solution
+tanh = beltsim.run(scene)
 fig, ax = plt.subplots(figsize=(7, 3.5), constrained_layout=True)
 ax.plot(x_exact, f_exact["friction"] / fstar, "k-", lw=1, label="exact solution")
-ax.plot(sol.x[on], ratio[on], "o", mfc="none", label='friction_law = "exact"')
-ax.plot(tanh.x[on], tanh.fields()["friction"][on] / fstar, "+", label='"tanh" (default)')
+ax.plot(res.x[on], ratio[on], "o", mfc="none", label='friction_law = "exact"')
+ax.plot(tanh.x[on], tanh.fields["friction"][on] / fstar, "+", label='"tanh" (default)')
 ax.set_xlim(0.58, 0.67)
 ax.set_xlabel("x [m]")
 ax.set_ylabel("f / f*")
@@ -48,8 +47,8 @@ ax.grid(alpha=0.3)
 ladder = [125, 250, 500, 1000, 2000]
 errors = {}
 for name, sc in (("tanh", scene), ("exact", exact_law)):
-    errors[name] = [beltsim.run(sc.with_overrides([f"numerics.elements={n}"]))
-                    .summary()["error"]["total_friction"] for n in ladder]
+    errors[name] = [beltsim.run(sc.with_overrides([("numerics.elements", n)]))
+                    .errors()["total_friction"] for n in ladder]
 fig, ax = plt.subplots(figsize=(6, 4), constrained_layout=True)
 for name, marker in (("tanh", "s"), ("exact", "o")):
     ax.loglog(ladder, errors[name], marker + "-", mfc="none", label=f'"{name}"')

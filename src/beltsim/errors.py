@@ -2,7 +2,7 @@
 
 Every user-facing problem is one of these, so the CLI can map it to an exit
 status and a one-line message without a traceback. Studies read their structured
-parts (:attr:`SceneError.key`, :attr:`NumericalError.kind`), never their messages.
+parts (``SceneError.key``, ``NumericalError.kind``), never their messages.
 """
 
 from __future__ import annotations
@@ -17,10 +17,10 @@ class BeltsimError(Exception):
 class SceneError(BeltsimError, ValueError):
     """A scene (file, key or value) breaks a rule; the message names key and rule.
 
-    ``SceneError(key, rule)`` reads ``"key: rule"`` and keeps the key in :attr:`key`
+    ``SceneError(key, rule)`` reads ``"key: rule"`` and keeps the key in ``key``
     (a scene key such as ``"numerics.max_work"``, which studies group refusals by);
     ``SceneError(message)`` is an error not about one key (a file that cannot be read),
-    whose :attr:`key` is None.
+    whose ``key`` is None.
     """
 
     def __init__(self, key_or_message: str, rule: str | None = None):
@@ -41,7 +41,7 @@ class NoSolutionError(BeltsimError, ValueError):
 
 
 class FailureKind(enum.Enum):
-    """What stopped a run on a numerical failure (:attr:`NumericalError.kind`, and a
+    """What stopped a run on a numerical failure (``NumericalError.kind``, and a
     failed run's ``RunResult.failure``); the value is what summary.json records."""
 
     #: a displacement or rotation became NaN or infinite
@@ -61,8 +61,9 @@ class FailureKind(enum.Enum):
 
 
 class NumericalError(BeltsimError, RuntimeError):
-    """A run stopped on a numerical failure of a :class:`FailureKind`; ``t`` is the
-    simulated time and ``quantity`` the field concerned, where known."""
+    """A run stopped on a numerical failure; ``kind`` is its
+    :class:`~beltsim.errors.FailureKind`, ``t`` the simulated time and ``quantity`` the
+    field concerned, where known."""
 
     def __init__(self, message: str, *, kind: FailureKind, t: float | None = None,
                  quantity: str | None = None):

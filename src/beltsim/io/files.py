@@ -97,6 +97,7 @@ def _jsonable(value):
 
 
 def write_json(path, obj) -> Path:
+    """Write ``obj`` as indented JSON, atomically; non-finite numbers become null."""
     return write_atomic(path, json.dumps(_jsonable(obj), indent=2) + "\n")
 
 

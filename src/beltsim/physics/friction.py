@@ -6,7 +6,7 @@ at 1; perfect adhesion is the "linear" law g(s) = s with a stiff slope f_s / v_r
 As v_reg -> 0 (Coulomb) or the slope -> infinity (adhesion) they tend to the exact
 laws, which are set-valued and carry no regularisation:
 
-* EXACT (Coulomb): |lam| <= 1 where v_rel = 0, lam = sign(v_rel) where it slides;
+* EXACT (Coulomb): abs(lam) <= 1 where v_rel = 0, lam = sign(v_rel) where it slides;
 * ADHESION: v_rel = 0, lam unbounded (the contact's reaction).
 
 Both are written as lam = proj(lam + v_rel / v_aug) (Alart and Curnier's
@@ -62,7 +62,7 @@ def law(code, s):
 
 @njit(cache=True)
 def law_inverse(code, lam):
-    """g^{-1}(lam) and its derivative, for the laws with a smooth inverse (|lam| < 1).
+    """g^{-1}(lam) and its derivative, for the laws with a smooth inverse (abs(lam) < 1).
 
     The primal-dual Newton iteration carries lam = g(v_rel / v_reg) as an unknown:
     its inverse is well conditioned where the primal law is nearly flat (sliding)
@@ -107,7 +107,7 @@ def law_numpy(code, s):
 
 
 def saturation(code) -> float:
-    """Level of |g| above which an element counts as sliding (adhesion never slides)."""
+    """Level of abs(g) above which an element counts as sliding (adhesion never slides)."""
     if code == ADHESION:
         return math.inf
     return 0.99 if code in (TANH, SQRT) else 1.0 - 1e-12

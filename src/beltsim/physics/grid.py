@@ -22,12 +22,15 @@ ANCHOR_ELEMENTS = 2
 
 @dataclass(frozen=True)
 class Grid:
+    """The nodes of a fixed (Eulerian) grid on [0, L], with nodes at x1 and x2."""
+
     x: np.ndarray  # node coordinates, x[0] = 0, x[-1] = L
     j1: int  # node index of x1
     j2: int  # node index of x2
 
     @property
     def n_elements(self) -> int:
+        """Number of elements N."""
         return len(self.x) - 1
 
     @property
@@ -46,6 +49,7 @@ class Grid:
 
     @property
     def h_min(self) -> float:
+        """The smallest element's length (m)."""
         return float(self.he.min())
 
 

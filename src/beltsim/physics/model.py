@@ -104,12 +104,15 @@ class State(NamedTuple):
 
     @classmethod
     def zeros(cls, n_nodes: int) -> State:
+        """The state at rest on ``n_nodes`` nodes."""
         return cls(*(np.zeros(n_nodes) for _ in cls._fields))
 
     def copy(self) -> State:
+        """A copy of every array."""
         return State(*(a.copy() for a in self))
 
     def assign(self, other) -> None:
+        """Copy another state's arrays into this one's, in place."""
         for a, b in zip(self, other):
             a[:] = b
 
@@ -131,6 +134,7 @@ class Loads(NamedTuple):
 
     @classmethod
     def none(cls, n_nodes: int) -> Loads:
+        """No loads on ``n_nodes`` nodes."""
         empty = np.zeros((0, n_nodes))
         return cls(np.zeros(0), empty, empty, empty, empty)
 
@@ -161,6 +165,7 @@ def hermite_weights(times, t):
 
 @njit(cache=True)
 def load_at(q, dq, k, w0, w1, v0, v1, j):
+    """A tabulated load at node j, from the weights of :func:`hermite_weights` (0 for k < 0)."""
     if k < 0:
         return 0.0
     return w0 * q[k, j] + w1 * q[k + 1, j] + v0 * dq[k, j] + v1 * dq[k + 1, j]
@@ -211,6 +216,7 @@ def contact_stencil(x, j1, j2):
 
 
 def mesh_of(grid) -> Mesh:
+    """The grid as the kernels read it (:class:`Mesh`), with its contact stencil."""
     c0, wf, sw = contact_stencil(grid.x, grid.j1, grid.j2)
     return Mesh(grid.he, grid.hbar, grid.j1, grid.j2, c0, wf, sw)
 

@@ -1,18 +1,16 @@
 """Linear stability of the discrete steady state: the eigenvalue with the largest real part.
 
-The residual kernel :func:`beltsim.physics.model.assemble` is written for backward Euler
-with ``inv_dt`` = s. With the old state equal to the steady state y0 and zero rates, its
-Jacobian at y0 is exactly the matrix polynomial of the semi-discrete model linearised
-about y0::
+The semi-discrete model linearised about the steady state y0 (zero rates),
 
-    P(s) = M s^2 + C s + K,   M = diag(rho hbar_j, I hbar_j) (lumped),
+    M z'' + C z' + K z = 0,   M = diag(rho hbar_j, I hbar_j) (lumped),
 
-so K = P(0) and C = (P(s0) - P(-s0)) / (2 s0) (exact for a quadratic; s0 is taken as
-sqrt(max K_ii / max M_ii), the grid's highest frequency, so that the three terms are of
-one size and nothing cancels). The friction enters through its slope at the steady slip
-velocities (the primal-dual form's condensed Jacobian is the same at a converged state).
-A perturbation y = y0 + z e^{lambda t} solves P(lambda) z = 0; the eigenvalues lambda
-are those of the companion matrix [[0, 1], [-M^-1 K, -M^-1 C]] (4 (N - 1) of them).
+comes from the vectorised reference of the model,
+:func:`beltsim.physics.reference.linearisation` (C = -df/dq', K = -df/dq, sparse), which
+the tests check against the numba kernel's Jacobian. The friction enters through its
+slope at the steady slip velocities (an exact law's through the stuck nodes' penalty
+slope). A perturbation y = y0 + z e^{lambda t} solves (M lambda^2 + C lambda + K) z = 0;
+the eigenvalues lambda are those of the companion matrix [[0, 1], [-M^-1 K, -M^-1 C]]
+(4 (N - 1) of them).
 
 How the largest real part is found (:func:`growth_rate`):
 
@@ -61,6 +59,7 @@ class Growth:
     coarse: Growth | None = None  # the coarse grid's, when the method is shift-invert
 
     def describe(self) -> str:
+        """The mode in words: its frequency and its growth or decay rate."""
         return (f"a mode at {self.frequency:.4g} Hz grows at {self.rate:.3g} 1/s"
                 if self.rate > 0 else
                 f"its least stable mode ({self.frequency:.4g} Hz) decays at "

@@ -1,7 +1,7 @@
 """Animated transients: friction, tension, moment, rotation and displacement over x.
 
 Reads the compact snapshot file of a run (``snapshots.npz``, see
-:func:`beltsim.results.write_snapshots`), so a long run can be animated later
+:func:`beltsim.io.results.write_snapshots`), so a long run can be animated later
 without running it again. Each frame shows the simulated fields, the contact zone,
 the analytic steady state (dashed) and the simulated time. Tension and moment come
 from the snapshots' u and theta as b1 du/dx and a dtheta/dx, with the nodal slopes

@@ -131,7 +131,7 @@ def save_figure(draw, path, *args, dpi=110, **kwargs) -> Path:
     Parameters
     ----------
     draw : callable
-        A drawing function that returns its Figure (e.g. :func:`plot_fields`).
+        A drawing function that returns its Figure (e.g. :func:`~beltsim.plot_fields`).
     path : str or Path
         The file (written atomically).
     *args, **kwargs

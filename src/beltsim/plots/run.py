@@ -1,12 +1,12 @@
 """A run drawn as figures: its final fields and its history, against the exact steady state.
 
-:func:`plot_fields` and :func:`plot_history` draw a run in memory (a
+:func:`~beltsim.plot_fields` and :func:`~beltsim.plot_history` draw a run in memory (a
 :class:`~beltsim.RunResult`, or a stored run that :func:`read_run` read back) or an
 :class:`~beltsim.AnalyticSolution`, on the caller's axes or a new figure, and return the
 Figure. :func:`plot_run` draws a stored run directory to files (``beltsim plot DIR``)
 through the same two functions: it reads nothing but the files the run wrote
-(:func:`beltsim.io.results.save_run`), so a run can be drawn long after it ended, on
-another machine, without running it again.
+(:func:`beltsim.save_run`), so a run can be drawn long after it ended, on another
+machine, without running it again.
 """
 
 from __future__ import annotations
@@ -124,12 +124,12 @@ def as_record(run) -> RunRecord:
 def plot_run(run_dir, out=None) -> list[Path]:
     """Draw the run stored in ``run_dir`` as ``fields.png`` and ``history.png`` in ``out``.
 
-    Reads only what ``beltsim run`` (or :func:`beltsim.io.results.save_run`) wrote in
-    ``run_dir`` (:func:`read_run`); the analytic steady state of the same scene is
-    computed afresh and overlaid where the scene has one. The figures are those of
-    :func:`plot_fields` (friction, tension, moment, rotation and displacement against x)
-    and :func:`plot_history` (the total friction and its stick and slip parts, the slip
-    start or the concentrated force, the slip power and the largest rate against t,
+    Reads only what ``beltsim run`` (or :func:`beltsim.save_run`) wrote in ``run_dir``
+    (:func:`read_run`); the analytic steady state of the same scene is computed afresh and
+    overlaid where the scene has one. The figures are those of :func:`~beltsim.plot_fields`
+    (friction, tension, moment, rotation and displacement against x) and
+    :func:`~beltsim.plot_history` (the total friction and its stick and slip parts, the
+    slip start or the concentrated force, the slip power and the largest rate against t,
     with the profile tables' row times and the analytic values marked), each written
     atomically.
 
@@ -172,7 +172,7 @@ def read_run(run_dir) -> RunRecord:
     Parameters
     ----------
     run_dir : str or Path
-        The output directory of ``beltsim run`` (or :func:`beltsim.io.results.save_run`).
+        The output directory of ``beltsim run`` (or :func:`beltsim.save_run`).
 
     Returns
     -------
@@ -301,7 +301,7 @@ def plot_fields(result, keys=None, ax=None, exact=True):
     Parameters
     ----------
     result : RunResult, RunRecord or AnalyticSolution
-        A run (in memory, or a stored one from :func:`read_run`), or an analytic
+        A run (in memory, or a stored one from :func:`~beltsim.plots.run.read_run`), or an analytic
         solution alone.
     keys : str or sequence of str, optional
         The fields, one panel each: ``"friction"``, ``"tension"``, ``"moment"``,
@@ -398,7 +398,7 @@ def plot_history(result, keys=None, ax=None, exact=True):
     Parameters
     ----------
     result : RunResult or RunRecord
-        A run in memory, or a stored one from :func:`read_run`.
+        A run in memory, or a stored one from :func:`~beltsim.plots.run.read_run`.
     keys : str or sequence of str, optional
         The panels: ``"total_friction"``, ``"slip_start"`` or ``"concentrated_force"``,
         ``"slip_power"``, ``"rate"`` and any other column, of those the run recorded

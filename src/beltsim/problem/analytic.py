@@ -71,6 +71,7 @@ class Segment:
 
     @property
     def length(self):
+        """q - p (m)."""
         return self.q - self.p
 
 
@@ -253,6 +254,7 @@ class AnalyticSolution:
 
     @property
     def total_friction(self) -> float:
+        """The friction force on the belt (N): distributed plus concentrated."""
         return self.distributed_friction + self.concentrated_force
 
     @property
@@ -284,6 +286,15 @@ class AnalyticSolution:
         return max(0.0, float(power))
 
     def summary(self) -> dict:
+        """The totals as summary.json holds them (keys that do not apply are None).
+
+        Returns
+        -------
+        dict
+            ``model``, ``inertia``, ``total_friction``, ``concentrated_force`` and
+            ``distributed_friction`` (perfect adhesion), ``stick_friction``,
+            ``slip_friction`` and ``slip_start`` (stick and slip), ``slip_power``.
+        """
         stick_model = self.model == "stick"
         return {
             "model": self.model,
@@ -349,6 +360,7 @@ class AnalyticSolution:
         return out
 
     def breakpoints(self):
+        """The points where a field's derivative may jump: x1, x2 and the slip start."""
         pts = [self.params.x1, self.params.x2]
         if self.model == "slip" and self.x_star is not None:
             pts.append(self.x_star)

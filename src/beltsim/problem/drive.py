@@ -42,6 +42,7 @@ class Profile(NamedTuple):
 
     @classmethod
     def constant(cls, value: float, ramp_time: float = 0.0) -> Profile:
+        """A profile that holds ``value`` (reached over ``ramp_time``, if given)."""
         return cls(np.zeros(0), np.zeros(0), float(value), 0.0, 0.0, float(ramp_time))
 
 

@@ -468,7 +468,7 @@ class Scene:
     Build it from a file (:meth:`load`), TOML text (:meth:`loads`), a nested dictionary
     (:meth:`from_dict`) or typed sections (:meth:`build`); derive others with
     :meth:`replace` (sections) or :meth:`with_overrides` (``SECTION.KEY=VALUE``). Every
-    way goes through :func:`validate`, so a scene that exists is a valid one.
+    way goes through :func:`~beltsim.problem.scene.validate`, so a scene that exists is a valid one.
 
     Parameters
     ----------

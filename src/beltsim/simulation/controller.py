@@ -106,25 +106,31 @@ class Simulation:
     # views ------------------------------------------------------------
     @property
     def scene(self) -> Scene:
+        """The scene."""
         return self.disc.scene
 
     @property
     def params(self):
+        """The scene's physical data (``scene.params``)."""
         return self.disc.params
 
     @property
     def numerics(self):
+        """The resolved numerical settings the scheme runs with."""
         return self.scheme.numerics
 
     @property
     def grid(self):
+        """The grid (:class:`beltsim.physics.grid.Grid`)."""
         return self.disc.grid
 
     @property
     def steps(self) -> int:
+        """Time steps taken so far."""
         return self.scheme.steps
 
     def total_friction(self) -> float:
+        """The state's total friction now (N), the sum of the nodal friction forces."""
         return self._measure()[0]
 
     def rate(self) -> float:
@@ -140,6 +146,7 @@ class Simulation:
         return self._measured
 
     def solution(self) -> DiscreteSolution:
+        """The state now, read as a solution (fields, totals, slip start)."""
         n = self.numerics
         # a steady solve's state is the final drive's, whatever the clock says
         mismatch = mismatch_at(self.disc.drive, self.t) if self.scheme.transient else None

@@ -29,7 +29,7 @@ class RunResult:
     """A run's outcome: how it ended, its final state, its history.
 
     The final state reads as arrays over the grid (:attr:`x`, :attr:`fields`), the
-    checks as arrays over time (:attr:`history`), the numbers the analytic solution
+    checks as arrays over time (``history``), the numbers the analytic solution
     also gives in :meth:`summary`, and the errors against it in :meth:`errors`.
 
     Attributes
@@ -95,22 +95,27 @@ class RunResult:
 
     @property
     def converged(self) -> bool:
+        """Whether the run reached steady state (status CONVERGED)."""
         return self.status is RunStatus.CONVERGED
 
     @property
     def failed(self) -> bool:
+        """Whether a numerical failure stopped it (status FAILED; see :attr:`failure`)."""
         return self.status is RunStatus.FAILED
 
     @property
     def interrupted(self) -> bool:
+        """Whether a signal, a callback or a tracker's :class:`~beltsim.Stop` ended it."""
         return self.status is RunStatus.INTERRUPTED
 
     @property
     def steps(self) -> int:
+        """Time steps taken (the steady scheme: its continuation stages)."""
         return self.statistics["steps"]
 
     @property
     def newton_iterations(self) -> int:
+        """Newton iterations over the run (0 for the explicit scheme)."""
         return self.statistics.get("newton_iterations", 0)
 
     @property
@@ -133,11 +138,33 @@ class RunResult:
         return {k: np.array(v) for k, v in fields.items()}  # copies: the state stays as it is
 
     def errors(self) -> dict | None:
+        """The final state's errors against :attr:`reference` (None without one).
+
+        Returns
+        -------
+        dict or None
+            Relative errors of ``total_friction``, ``u``, ``theta`` (largest difference
+            over the nodes over the exact field's largest magnitude), ``slip_power`` and
+            ``concentrated_force`` (perfect adhesion), and the absolute error of
+            ``slip_start`` in m (stick and slip); keys that do not apply are None.
+        """
         if self.reference is None:
             return None
         return compare(self.solution, self.reference)
 
     def summary(self) -> dict:
+        """What ``summary.json`` holds: the final state's totals and how the run went.
+
+        Returns
+        -------
+        dict
+            The keys of :meth:`beltsim.AnalyticSolution.summary`, read off the final
+            state, and ``converged``, ``simulated_time``, ``steps``, ``rejected_steps``,
+            ``time_accurate``, ``wall_time``, ``compile_time``, ``reason``, ``failure``
+            (a :class:`~beltsim.errors.FailureKind` value or None), ``elements``,
+            ``integrator``, ``power_balance``, ``periodic`` and ``error``
+            (:meth:`errors`).
+        """
         out = self.solution.summary()
         out.update(converged=self.converged, simulated_time=self.simulated_time,
                    steps=self.steps, rejected_steps=self.statistics.get("rejected_steps", 0),

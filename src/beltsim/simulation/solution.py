@@ -77,10 +77,12 @@ class DiscreteSolution:
 
     @property
     def x(self):
+        """The grid's nodes (m)."""
         return self.grid.x
 
     @property
     def traction(self) -> np.ndarray:
+        """The friction traction (N/m) at the nodes, as ``fields()['friction']``."""
         return traction(self.fnode, self.wf)
 
     def fields(self) -> dict:
@@ -93,6 +95,7 @@ class DiscreteSolution:
     # totals ---------------------------------------------------------
     @property
     def total_friction(self) -> float:
+        """The sum of the nodal friction forces (N)."""
         return float(self.fnode.sum())
 
     def _sliding(self):
@@ -176,6 +179,7 @@ class DiscreteSolution:
 
     @property
     def slip_start(self) -> float:
+        """Where the slip zone that ends at x2 starts (m), read inside its first cell."""
         return self._slip_front()[0]
 
     @property
@@ -266,24 +270,29 @@ class DiscreteReference:
         self.model = "stick" if sol.params.friction == "stick" else "slip"
 
     def fields(self, x) -> dict:
+        """The state's nodal fields; ``x`` must be its own grid's nodes."""
         if not np.array_equal(np.asarray(x), self.sol.x):
             raise ValueError("a discrete reference compares states on its own grid only")
         return self.sol.fields()
 
     @property
     def total_friction(self) -> float:
+        """The state's total friction (N)."""
         return self.sol.total_friction
 
     @property
     def slip_power(self) -> float:
+        """The state's slip power from the steady energy balance (W)."""
         return self.sol.steady_slip_power
 
     @property
     def concentrated_force(self) -> float:
+        """The state's concentrated force at x2 (N, perfect adhesion)."""
         return self.sol.concentrated_force
 
     @property
     def x_star(self) -> float:
+        """The state's slip start (m), in the analytic solution's name."""
         return self.sol.slip_start
 
 

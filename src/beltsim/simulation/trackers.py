@@ -172,6 +172,7 @@ class HistoryTracker(Tracker):
         return None
 
     def arrays(self) -> dict:
+        """The history as arrays, one entry a check (``RunResult.history``)."""
         return {k: np.array(v) for k, v in self.data.items()}
 
     def state(self):
@@ -223,6 +224,7 @@ class SteadyStateTracker(Tracker):
         return None
 
     def not_steady(self, t_end: float) -> str:
+        """The reason of a run that reached t_end before steady state."""
         return (f"not steady by t_end = {t_end:.6g} s (rate {self.rate:.3g}, friction change "
                 f"{self.change:.3g} per window; tolerance {self.tol:.3g})")
 
@@ -288,6 +290,7 @@ class PeriodicTracker(Tracker):
         return out
 
     def not_steady(self, t_end: float) -> str:
+        """The reason of a run that reached t_end before its periodic steady state."""
         return (f"no periodic steady state by t_end = {t_end:.6g} s (change between the "
                 f"last two periods {self.change:.3g}; tolerance {self.tol:.3g})")
 
@@ -313,6 +316,7 @@ class SnapshotTracker(Tracker):
         self.fields: dict = {k: [] for k in self.KEYS}
 
     def take(self, sim):
+        """Store the state now."""
         self.times.append(sim.t)
         self.fields["u"].append(sim.state.u.copy())
         self.fields["theta"].append(sim.state.theta.copy())
@@ -332,6 +336,7 @@ class SnapshotTracker(Tracker):
             self.take(sim)
 
     def arrays(self) -> dict:
+        """The snapshots as arrays (``RunResult.snapshots``): ``t`` and (times, nodes)."""
         return {"t": np.array(self.times), **{k: np.array(v) for k, v in self.fields.items()}}
 
     def state(self):
@@ -362,6 +367,7 @@ class PowerBalanceTracker(Tracker):
             self.initial_energy = stored_energy(sim.state, sim.disc.mesh, sim.disc.model)
 
     def balance(self, sim) -> dict:
+        """The energy balance over the run so far (J): ``RunResult.power_balance``."""
         from ..physics.model import stored_energy
         work = sim.scheme.work_integrals()
         change = stored_energy(sim.state, sim.disc.mesh, sim.disc.model) - self.initial_energy

@@ -1,4 +1,5 @@
-"""What every scheme works on (:class:`Discretisation`) and the interface it offers."""
+"""What every scheme works on (:class:`~beltsim.solvers.base.Discretisation`) and the
+interface it offers."""
 
 from __future__ import annotations
 
@@ -109,4 +110,5 @@ class Scheme:
         return {"steps": np.array(self.steps)}
 
     def restore(self, data: dict) -> None:
+        """Take back what :meth:`checkpoint` returned."""
         self.steps = int(data["steps"])

@@ -93,6 +93,7 @@ class History(NamedTuple):
 
     @classmethod
     def zeros(cls, n_nodes):
+        """All zero on ``n_nodes`` nodes."""
         return cls(*(np.zeros(n_nodes) for _ in cls._fields))
 
 

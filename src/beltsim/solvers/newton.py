@@ -44,6 +44,8 @@ STATS_DTYPE = np.dtype([("newton_iterations", np.int64), ("failed_steps", np.int
 
 
 class NewtonSettings(NamedTuple):
+    """Newton's stopping rule: the tolerance and the most iterations."""
+
     tol: float  # scaled max norm of the update
     max_iterations: int
 
@@ -72,6 +74,7 @@ class Workspace(NamedTuple):
 
     @classmethod
     def allocate(cls, n_elements: int, exact: bool = False) -> Workspace:
+        """The arrays for a grid of ``n_elements`` (``exact``: an exact law's too)."""
         N, n = n_elements, n_elements - 1
         return cls(R=np.zeros((n, 2)), Lb=np.zeros((n, 2, 2)), L2=np.zeros((n, 2, 2)),
                    Db=np.zeros((n, 2, 2)),
@@ -86,6 +89,7 @@ class Workspace(NamedTuple):
 
 @njit(cache=True)
 def merit(R, scales):
+    """The squared residual norm, each row's force and moment over their scales."""
     m = 0.0
     for i in range(R.shape[0]):
         a = R[i, 0] / scales.force
@@ -186,7 +190,8 @@ def factorise(w, mesh):
 
 @njit(cache=True)
 def friction_forces(lam, fnode, t, mesh, p, drive):
-    """The nodal friction forces of the friction ratios lam, as :func:`assemble` sets them."""
+    """The nodal friction forces of the friction ratios lam, as
+    :func:`~beltsim.physics.model.assemble` sets them."""
     fs = p.friction_scale * friction_factor(drive, t)
     for j in range(mesh.c0, mesh.j2 + 1):
         fnode[j] = -mesh.wf[j] * fs * lam[j]
@@ -202,7 +207,7 @@ def release_stuck_ratios(lam, w, mesh, code):
     convergence test. Such a ratio (sg below NEAR_BOUND, off g(v_rel / v_reg) of the
     iterate before the update by more than LAW_GAP) is not converged: it restarts from
     0, where the slope is largest (from the bound the update grows only by a factor
-    1 + 2 |rl| per iteration), and Newton goes on.
+    1 + 2 abs(rl) per iteration), and Newton goes on.
     """
     stuck = False
     for j in range(mesh.c0, mesh.j2 + 1):

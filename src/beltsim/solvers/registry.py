@@ -22,10 +22,12 @@ def register(cls):
 
 
 def names() -> tuple[str, ...]:
+    """The registered schemes' names, the values of ``numerics.integrator``."""
     return tuple(_REGISTRY)
 
 
 def get(name: str) -> type:
+    """The scheme class registered as ``name``; SceneError for an unknown name."""
     try:
         return _REGISTRY[name]
     except KeyError:

@@ -42,6 +42,7 @@ class Saddle(NamedTuple):
 
     @classmethod
     def allocate(cls, n_elements: int) -> Saddle:
+        """The arrays for a grid of ``n_elements``."""
         n = max(n_elements - 1, 0)
         z = np.zeros
         return cls(z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)),
@@ -49,6 +50,7 @@ class Saddle(NamedTuple):
 
     @classmethod
     def empty(cls) -> Saddle:
+        """Zero-size arrays, for a law that needs none (a regularised one)."""
         return cls.allocate(0)
 
 
