@@ -65,7 +65,7 @@ class Numerics:
     dt: float
     t_end: float
     ramp_time: float
-    law: str
+    friction_law: str  # the scene key's law, or the stick scene's linear/adhesion
     regularisation: float  # the friction law's velocity scale: v_reg, v_aug (exact), 1 (linear)
     friction_scale: float  # f_s in f = -f_s g(v_rel / v_reg)
     acceleration: float  # numerical damping (1/s) of the pseudo-transient scheme
@@ -80,7 +80,7 @@ class Numerics:
     @property
     def law_code(self) -> int:
         """The friction law's code as the kernels read it (``physics.friction.LAW_CODES``)."""
-        return LAW_CODES[self.law]
+        return LAW_CODES[self.friction_law]
 
 
 def resolve(scene: Scene, elements: int | None = None) -> Numerics:
@@ -153,7 +153,8 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         integrator=integrator,
         elements=elements,
         grading=nm.get("grading", DEFAULT_GRADING),
-        dt=dt, t_end=t_end, ramp_time=ramp_time, law=law, regularisation=regularisation,
+        dt=dt, t_end=t_end, ramp_time=ramp_time, friction_law=law,
+        regularisation=regularisation,
         friction_scale=friction_scale,
         acceleration=acceleration, steady_tol=nm.get("steady_tol", 1e-6),
         snapshot_interval=nm.get("snapshot_interval"),
