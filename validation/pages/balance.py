@@ -49,7 +49,7 @@ HEADER = ["run", "status", "simulated time [s]", "steps", *(f"{t} [J]" for _, t 
 
 
 def build(page: Page, quick: bool) -> None:
-    grid = [f"numerics.elements={QUICK_ELEMENTS}"] if quick else []
+    grid = [("numerics.elements", QUICK_ELEMENTS)] if quick else []
     where = f"{QUICK_ELEMENTS} elements" if quick else "each scene's default grid"
     page.para(
         "The implicit scheme integrates the power terms of the semi-discrete model along "
@@ -77,7 +77,7 @@ def build(page: Page, quick: bool) -> None:
     page.heading("paper_slip as time_tol shrinks")
     rows, rel = [], []
     for tol in TOLS[quick]:
-        res = run(shipped_scene("paper_slip", [*grid, f"numerics.time_tol={tol!r}"]),
+        res = run(shipped_scene("paper_slip", [*grid, ("numerics.time_tol", tol)]),
                   raise_on_failure=False)
         rows.append(_row(page, f"time_tol {num(tol)}", res))
         if res.power_balance and res.power_balance["relative_residual"] is not None:

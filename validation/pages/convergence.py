@@ -25,7 +25,7 @@ LADDERS = {False: (LADDER, None), True: ((60, 120, 240), ("steady", "implicit", 
 #: the exact (set-valued) friction law on paper_slip
 EXACT_LADDERS = {False: ((250, 500, 1000, 2000, 4000), ("steady", "implicit", RICHARDSON)),
                  True: ((60, 120, 240), ("steady", "implicit", RICHARDSON))}
-EXACT_LAW = 'numerics.friction_law="exact"'
+EXACT_LAW = ("numerics.friction_law", "exact")
 TITLES = {"total_friction": "total friction", "u": "u", "theta": "theta",
           "concentrated_force": "conc. force", "slip_start": "slip start [m]"}
 

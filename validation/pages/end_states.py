@@ -38,7 +38,7 @@ def _judge(page: Page, where: str, converged: bool, reason, err: dict) -> str:
 
 def scene_rows(page: Page, name: str, quick: bool) -> list[dict]:
     """Every applicable scheme, and Richardson's extrapolation, on one scene."""
-    scene = shipped_scene(name, [f"numerics.elements={QUICK_ELEMENTS}"] if quick else [])
+    scene = shipped_scene(name, [("numerics.elements", QUICK_ELEMENTS)] if quick else [])
     ref = reference_of(scene)
     rows = []
     for scheme in solvers.names():
@@ -46,7 +46,7 @@ def scene_rows(page: Page, name: str, quick: bool) -> list[dict]:
         if why_not:
             rows.append({"scheme": scheme, "status": "not applicable", "reason": why_not})
             continue
-        sim = Simulation(scene.with_overrides([f"numerics.integrator={scheme}"]))
+        sim = Simulation(scene.with_overrides([("numerics.integrator", scheme)]))
         res = sim.run(raise_on_failure=False)
         res.reference = ref
         err = res.errors() or {}

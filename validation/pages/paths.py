@@ -36,20 +36,20 @@ def thin_overrides() -> list[str]:
     """The thin-belt limit of the paper's data: quasistatic, h = 1e-6 m, and the
     stiffnesses a, b1, b2 of the paper's h = 0.1 m held fixed."""
     P = shipped_scene("paper_slip").params
-    return ["physics.inertia=false", "beam.height=1e-6", f"stiffness.bending={P.a!r}",
-            f"stiffness.tension={P.b1!r}", f"stiffness.shear={P.b2!r}"]
+    return [("physics.inertia", False), ("beam.height", 1e-6), ("stiffness.bending", P.a),
+            ("stiffness.tension", P.b1), ("stiffness.shear", P.b2)]
 
 
 def _thin_run(kind: str, scheme: str, elements: int, step: float):
     """One run of the thin scene on a uniform grid; returns (scene, result)."""
-    common = [*thin_overrides(), "numerics.grading=1", f"numerics.elements={elements}",
-              f"numerics.integrator={scheme}"]
+    common = [*thin_overrides(), ("numerics.grading", 1), ("numerics.elements", elements),
+              ("numerics.integrator", scheme)]
     if scheme == "implicit":  # BDF2 at a fixed step: time_tol far above any estimate
-        extra = ['numerics.friction_law="exact"', "numerics.time_tol=10.0",
-                 f"numerics.dt={step!r}", f"numerics.snapshot_interval={step!r}",
-                 f"numerics.t_end={T_SHORT!r}"]
+        extra = [("numerics.friction_law", "exact"), ("numerics.time_tol", 10.0),
+                 ("numerics.dt", step), ("numerics.snapshot_interval", step),
+                 ("numerics.t_end", T_SHORT)]
     else:  # backward Euler at the nominal step, to steady state
-        extra = [f"numerics.dt={step!r}", f"numerics.snapshot_interval={SNAP!r}"]
+        extra = [("numerics.dt", step), ("numerics.snapshot_interval", SNAP)]
     scene = shipped_scene(THIN_SCENES[kind], [*common, *extra])
     return scene, Simulation(scene).run(raise_on_failure=False)
 
@@ -175,7 +175,7 @@ def _common(ref, res, page: Page, label: str):
 
 def tolerance_section(page: Page, quick: bool) -> None:
     cfg = TOLS[quick]
-    grid = [f"numerics.elements={cfg['elements']}"] if cfg["elements"] else []
+    grid = [("numerics.elements", cfg['elements'])] if cfg["elements"] else []
     where = f"{cfg['elements']} elements" if cfg["elements"] else "the default grid"
     page.heading("The default time tolerance's path error on paper_slip")
     page.para(
@@ -192,7 +192,7 @@ def tolerance_section(page: Page, quick: bool) -> None:
         f"within a step of the implicit ones, so its history is moved onto them with its "
         f"own slope.")
     scene = shipped_scene("paper_slip", grid)
-    ref = run(scene.with_overrides([f"numerics.time_tol={cfg['reference']!r}"]),
+    ref = run(scene.with_overrides([("numerics.time_tol", cfg['reference'])]),
               raise_on_failure=False)
     if not ref.converged:
         page.fail(f"time_tol {num(cfg['reference'])} reference: {ref.reason}")
@@ -202,7 +202,7 @@ def tolerance_section(page: Page, quick: bool) -> None:
              "converged" if ref.converged else FAILED]]
     diffs, curves = [], {}
     for tol in cfg["tols"]:
-        res = run(scene.with_overrides([f"numerics.time_tol={tol!r}"]), raise_on_failure=False)
+        res = run(scene.with_overrides([("numerics.time_tol", tol)]), raise_on_failure=False)
         t, f_ref, f = _common(ref, res, page, f"time_tol {num(tol)}")
         d = float(np.max(np.abs(f - f_ref)) / F)
         diffs.append((tol, d))
@@ -216,7 +216,7 @@ def tolerance_section(page: Page, quick: bool) -> None:
                      status])
         if tol == DEFAULT_TIME_TOL:
             default = d
-    exp = run(scene.with_overrides(["numerics.integrator=explicit"]), raise_on_failure=False)
+    exp = run(scene.with_overrides([("numerics.integrator", "explicit")]), raise_on_failure=False)
     t_ref, f_ref = ref.history["t"], ref.history["total_friction"]
     t, f = exp.history["t"], exp.history["total_friction"]
     n = min(len(t), len(t_ref))
