@@ -181,10 +181,8 @@ def cmd_bench(args):
     from .problem.scene import load_scene
     from .studies import bench as studies
 
-    overrides = list(args.overrides)
-    if args.elements is not None:
-        overrides.append(f"numerics.elements={args.elements}")
-    scene = load_scene(args.scene, overrides)
+    grid = [("numerics.elements", args.elements)] if args.elements is not None else []
+    scene = load_scene(args.scene, [*args.overrides, *grid])
     result = studies.bench(scene, cold=not args.no_cold, repeat=args.repeat)
     print(studies.bench_json(result))
     return 0
@@ -198,7 +196,7 @@ def cmd_stability(args):
     from .studies.convergence import ERROR_KEYS
 
     out = prepare_outdir(args.out or Path("runs/out/stability"))
-    extra = [f"numerics.elements={args.elements}"] if args.elements else []
+    extra = [("numerics.elements", args.elements)] if args.elements else []
     cases = studies.STABILITY_CASES
     if args.elements:  # a coarse matrix: a case about the grid is the others coarsened
         cases = tuple(c for c in cases if not c.sets_grid)
