@@ -164,11 +164,10 @@ def stability_cell(case: Case, scheme: str, extra=(), bounds=None, discrete=Fals
         cell.update(status=CellStatus.REFUSED, reason=str(exc), reason_key=key or "")
         return cell
     res = sim.run(raise_on_failure=False)
-    res.reference = _discrete_reference(scene) if discrete else None
-    if res.reference is None:
-        res.reference, discrete = reference_of(scene), False
-    else:
+    own_grid = _discrete_reference(scene) if discrete else None
+    if own_grid is not None:
         bounds = DISCRETE_BOUNDS
+    res.reference = own_grid if own_grid is not None else reference_of(scene)
     err = res.errors() or {}
     cell.update(dt=sim.numerics.dt if sim.scheme.transient else float("nan"),
                 steps=res.steps, wall_time=res.wall_time,
