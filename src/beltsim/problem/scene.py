@@ -854,9 +854,12 @@ def set_key(data: dict, key: str, value) -> None:
 
 
 def scene_names() -> tuple[str, ...]:
-    """The names of the scenes shipped with beltsim (``beltsim run NAME`` runs one)."""
-    return tuple(sorted(f.name[:-5] for f in _scenes_dir().iterdir()
-                        if f.name.endswith(".toml")))
+    """The names of the scenes shipped with beltsim (``beltsim run NAME`` runs one); none
+    where the package was installed without them."""
+    folder = _scenes_dir()
+    if not folder.is_dir():
+        return ()
+    return tuple(sorted(f.name[:-5] for f in folder.iterdir() if f.name.endswith(".toml")))
 
 
 def _scenes_dir():
@@ -873,7 +876,7 @@ def shipped_scene(name: str, overrides=()) -> Scene:
     """
     resource = _scenes_dir() / f"{name}.toml"
     if not resource.is_file():
-        known = ", ".join(scene_names()) if _scenes_dir().is_dir() else "none installed"
+        known = ", ".join(scene_names()) or "none installed"
         raise MissingInputError(f"{name}: no scene of that name ships with beltsim "
                                 f"(shipped: {known})")
     scene = Scene.loads(resource.read_text(encoding="utf-8"), source=name)
