@@ -1,0 +1,373 @@
+"""Closed-drive scenes: a belt loop on a driver and a driven pulley.
+
+A scene with a ``[drive]`` section is a closed drive. Its sections:
+
+* ``[belt]``: the belt's cross-section and material (the ``[beam]`` keys without
+  ``length``: the loop's length follows from the geometry);
+* ``[stiffness]`` (optional): a, b1, b2, rho, I given directly, as for a straight belt;
+* ``[drive]``: the pulleys, the pretension, the driver's speed, the load and the driven
+  pulley's inertia;
+* ``[contact]``: ``friction`` ("coulomb" or "stick") and ``friction_coefficient`` (mu);
+* ``[physics]``: ``inertia``, ``damping`` and ``model`` ("beam": the shear-deformable
+  beam; "string": the extensible string, whose friction has no lever about the middle
+  line);
+* ``[numerics]``: how the problem is solved, never which problem.
+
+Validation happens in :func:`validate`; every rule raises a one-line
+:class:`~beltsim.errors.SceneError` naming the key.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import SceneError
+from ..problem.scene import (
+    _RETIRED,
+    POS,
+    PROFILE,
+    _Rule,
+    _number,
+    _show,
+    _toml_value,
+    final_value,
+    parse_assignment,
+)
+from .geometry import Geometry, GeometryError
+
+#: The fewest elements on each of the loop's four segments.
+MIN_SEGMENT_ELEMENTS = 4
+
+
+def _check_load(key, value):
+    """A load torque (N m): a number >= 0 (ramped from 0) or a table of [time, value] rows."""
+    if isinstance(value, list):
+        rows = []
+        if not value:
+            raise SceneError(key, "a table needs at least one [time, value] row")
+        for i, row in enumerate(value, 1):
+            name = f"{key} row {i}"
+            if not isinstance(row, list) or len(row) != 2:
+                raise SceneError(name, f"must be a [time, value] pair, got {_show(row)}")
+            t, v = _number(f"{name} time", row[0]), _number(f"{name} value", row[1])
+            if rows and not t > rows[-1][0]:
+                raise SceneError(name, f"times must increase strictly, got {t!r} after "
+                                 f"{rows[-1][0]!r}")
+            if not v >= 0:
+                raise SceneError(f"{name} value", f"must be >= 0, got {v!r}")
+            rows.append([t, v])
+        return rows
+    value = _number(key, value)
+    if not value >= 0:
+        raise SceneError(key, f"must be >= 0, got {value!r}")
+    return value
+
+
+class _LoadRule(_Rule):
+    def __init__(self):
+        super().__init__("load")
+
+    def check(self, key, value):
+        return _check_load(key, value)
+
+
+#: Sections of a drive scene, their keys and rules.
+SCHEMA: dict[str, dict[str, _Rule]] = {
+    "belt": {
+        "height": POS,
+        "width": POS,
+        "youngs_modulus": POS,
+        "poisson_ratio": _Rule("float", interval=(-1.0, 0.5)),
+        "density": POS,
+        "shear_factor": POS,
+    },
+    "stiffness": {
+        "bending": POS,
+        "tension": POS,
+        "shear": POS,
+        "mass": POS,
+        "rotary_inertia": POS,
+    },
+    "drive": {
+        "driver_radius": POS,
+        "driven_radius": POS,
+        "centre_distance": POS,
+        "installation_tension": POS,
+        "driver_speed": PROFILE,
+        "load_torque": _LoadRule(),
+        "driven_inertia": POS,
+    },
+    "contact": {
+        "friction": _Rule("str", choices=("stick", "coulomb")),
+        "friction_coefficient": POS,
+    },
+    "physics": {
+        "inertia": _Rule("bool"),
+        "damping": _Rule("float", nonneg=True),
+        "model": _Rule("str", choices=("beam", "string")),
+    },
+    "numerics": {
+        "integrator": _Rule("str", choices=("implicit", "steady")),
+        "elements": _Rule("int", minimum=4 * MIN_SEGMENT_ELEMENTS),
+        "dt": POS,
+        "t_end": POS,
+        "ramp_time": _Rule("float", nonneg=True),
+        "friction_law": _Rule("str", choices=("exact", "tanh", "sqrt")),
+        "regularisation": POS,
+        "time_tol": POS,
+        "steady_tol": POS,
+        "newton_tol": POS,
+        "newton_max_iterations": _Rule("int", minimum=1),
+        "snapshot_interval": POS,
+    },
+}
+REQUIRED = {"belt": ("height", "width", "youngs_modulus", "poisson_ratio", "shear_factor"),
+            "drive": ("driver_radius", "driven_radius", "centre_distance",
+                      "installation_tension", "driver_speed", "load_torque",
+                      "driven_inertia"),
+            "contact": ("friction",),
+            "physics": ("inertia",)}
+OPTIONAL_SECTIONS = ("stiffness", "numerics")
+
+
+def is_drive(data) -> bool:
+    """Whether scene data (a dict) describes a closed drive: it has a [drive] section."""
+    return isinstance(data, dict) and "drive" in data
+
+
+def validate(data: dict) -> dict:
+    """Check a drive scene's data and return a normalised deep copy.
+
+    Raises
+    ------
+    SceneError
+        On the first broken rule, naming the key and the rule.
+    """
+    if not isinstance(data, dict):
+        raise SceneError("scene: must be a TOML table")
+    out: dict = {}
+    for key, value in data.items():
+        if key == "title":
+            if not isinstance(value, str):
+                raise SceneError("title", f"must be a string, got {_show(value)}")
+            out["title"] = value
+        elif key in SCHEMA:
+            if not isinstance(value, dict):
+                raise SceneError(f"[{key}]", f"must be a table (section), got {_show(value)}")
+        elif key in ("beam", "motion"):
+            raise SceneError(f"[{key}]", "not in a closed drive (a scene with [drive] "
+                             "describes its belt in [belt] and its motion in [drive])")
+        else:
+            known = ", ".join([f"[{s}]" for s in SCHEMA] + ["title"])
+            raise SceneError(key, f"unknown section or key of a drive scene (known: {known})")
+    for section, rules in SCHEMA.items():
+        if section not in data:
+            if section not in OPTIONAL_SECTIONS:
+                raise SceneError(f"[{section}]", "missing section")
+            continue
+        clean = {}
+        for key, value in data[section].items():
+            name = f"{section}.{key}"
+            if (section, key) in _RETIRED:
+                raise SceneError(name, _RETIRED[section, key])
+            if key not in rules:
+                raise SceneError(name, f"unknown key (known in [{section}]: "
+                                 f"{', '.join(rules)})")
+            clean[key] = rules[key].check(name, value)
+        out[section] = clean
+    for section, keys in REQUIRED.items():
+        for key in keys:
+            if key not in out[section]:
+                raise SceneError(f"{section}.{key}", "missing key")
+    contact, physics = out["contact"], out["physics"]
+    if contact["friction"] == "coulomb" and "friction_coefficient" not in contact:
+        raise SceneError("contact.friction_coefficient",
+                         'missing key (required when contact.friction = "coulomb")')
+    if contact["friction"] == "stick" and "friction_coefficient" in contact:
+        raise SceneError("contact.friction_coefficient",
+                         'only for contact.friction = "coulomb" (this scene is "stick")')
+    if physics["inertia"] and "density" not in out["belt"] and not {
+            "mass", "rotary_inertia"} <= set(out.get("stiffness", {})):
+        raise SceneError("belt.density", "missing key (required when physics.inertia = true)")
+    if not physics["inertia"]:
+        for key in ("mass", "rotary_inertia"):
+            if key in out.get("stiffness", {}):
+                raise SceneError(f"stiffness.{key}", "only for physics.inertia = true (a "
+                                 "quasistatic scene has no inertia terms)")
+    num = out.get("numerics", {})
+    law = num.get("friction_law")
+    if contact["friction"] == "stick" and law not in (None, "exact"):
+        raise SceneError("numerics.friction_law", f'a "stick" drive takes only "exact", '
+                         f'got "{law}"')
+    if "regularisation" in num and (law in (None, "exact")):
+        raise SceneError("numerics.regularisation", 'only with a regularised '
+                         'numerics.friction_law ("tanh" or "sqrt"): exact friction has none')
+    drive = out["drive"]
+    try:
+        Geometry(drive["driver_radius"], drive["driven_radius"], drive["centre_distance"])
+    except GeometryError as exc:
+        raise SceneError(str(exc)) from None
+    P = _params(out)
+    if P.rho > 0 and max_rim_speed(out) ** 2 * P.rho >= P.b1:
+        raise SceneError("drive.driver_speed", f"the rim speed reaches the belt's critical "
+                         f"speed sqrt(b1 / rho) = {math.sqrt(P.b1 / P.rho):.4g} m/s")
+    return out
+
+
+def max_rim_speed(data: dict) -> float:
+    """The largest rim speed omega1 R1 (m/s) of the driver's speed profile."""
+    from ..problem.scene import profile_extremes
+
+    return profile_extremes(data["drive"]["driver_speed"])[1] * data["drive"]["driver_radius"]
+
+
+@dataclass(frozen=True)
+class DriveParams:
+    """The physical data of a closed drive, in SI units (the final values of profiles).
+
+    ``rho`` and ``I`` are zero for a quasistatic scene; ``mu`` is None for perfect
+    adhesion ("stick"); ``lever`` is h / 2 for the beam and 0 for the string.
+    """
+
+    h: float
+    a: float
+    b1: float
+    b2: float
+    rho: float
+    I: float
+    inertia: bool
+    damping: float
+    model: str
+    friction: str
+    mu: float | None
+    N0: float
+    J2: float
+    omega1: float
+    M2: float
+    geometry: Geometry
+
+    @property
+    def lever(self) -> float:
+        """The friction's lever about the middle line: h / 2 (beam) or 0 (string)."""
+        return 0.5 * self.h if self.model == "beam" else 0.0
+
+
+def _params(d: dict) -> DriveParams:
+    from ..problem.scene import _stiffness
+
+    beam = dict(d["belt"])
+    stiff = _stiffness({"beam": beam, "stiffness": d.get("stiffness", {}),
+                        "physics": d["physics"]})
+    drive, contact, physics = d["drive"], d["contact"], d["physics"]
+    load = drive["load_torque"]
+    return DriveParams(
+        h=beam["height"], a=stiff["a"], b1=stiff["b1"], b2=stiff["b2"], rho=stiff["rho"],
+        I=stiff["I"], inertia=physics["inertia"],
+        damping=physics.get("damping", 0.0) if physics["inertia"] else 0.0,
+        model=physics.get("model", "beam"), friction=contact["friction"],
+        mu=contact.get("friction_coefficient"), N0=drive["installation_tension"],
+        J2=drive["driven_inertia"], omega1=final_value(drive["driver_speed"]),
+        M2=float(load[-1][1] if isinstance(load, list) else load),
+        geometry=Geometry(drive["driver_radius"], drive["driven_radius"],
+                          drive["centre_distance"]))
+
+
+class DriveScene:
+    """A validated closed-drive scene.
+
+    Build it from a file (:meth:`load`), TOML text (:meth:`loads`) or nested tables
+    (:meth:`from_dict`); derive others with :meth:`with_overrides`.
+
+    Raises
+    ------
+    SceneError
+        On the first broken rule, naming the key and the rule.
+    """
+
+    def __init__(self, data: dict, source: str | None = None):
+        self._data = validate(data)
+        self.source = source
+        self.params = _params(self._data)
+
+    @classmethod
+    def load(cls, path) -> DriveScene:
+        """Read and validate a drive scene file (TOML)."""
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise SceneError(f"{path}: scene file not found") from None
+        except (OSError, UnicodeDecodeError) as exc:
+            raise SceneError(f"{path}: cannot read scene file ({exc})") from None
+        return cls.loads(text, source=str(path))
+
+    @classmethod
+    def loads(cls, text: str, source: str | None = None) -> DriveScene:
+        """Parse and validate a drive scene from TOML text."""
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise SceneError(f"{source or 'scene'}: malformed TOML ({exc})") from None
+        return cls(data, source=source)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> DriveScene:
+        """A drive scene from nested tables (the scene keeps a copy)."""
+        return cls(copy.deepcopy(data))
+
+    def to_dict(self) -> dict:
+        """The scene's tables (a copy)."""
+        return copy.deepcopy(self._data)
+
+    def to_toml(self) -> str:
+        """The scene as TOML text, which :meth:`loads` reads back to an equal scene."""
+        lines = []
+        if "title" in self._data:
+            lines.append(f"title = {_toml_value(self._data['title'])}")
+        for section in SCHEMA:
+            if section in self._data and self._data[section]:
+                lines.append(f"\n[{section}]")
+                lines += [f"{k} = {_toml_value(v)}" for k, v in self._data[section].items()]
+        return "\n".join(lines) + "\n"
+
+    def with_overrides(self, overrides) -> DriveScene:
+        """A copy with ``SECTION.KEY=VALUE`` strings or (key, value) pairs applied."""
+        data = self.to_dict()
+        for item in overrides:
+            key, value = parse_assignment(item) if isinstance(item, str) else item
+            if "." not in key:
+                raise SceneError(key, "expected SECTION.KEY")
+            section, name = key.split(".", 1)
+            if section not in SCHEMA:
+                raise SceneError(key, f"unknown section [{section}] of a drive scene "
+                                 f"(sections: {', '.join(SCHEMA)})")
+            data.setdefault(section, {})[name] = value
+        return DriveScene(data, source=self.source)
+
+    @property
+    def title(self) -> str:
+        """The scene's title ("" if none)."""
+        return self._data.get("title", "")
+
+    @property
+    def numerics(self) -> dict:
+        """The ``[numerics]`` table as given (defaults are resolved by the solver)."""
+        return dict(self._data.get("numerics", {}))
+
+    @property
+    def drive(self) -> dict:
+        """The ``[drive]`` table."""
+        return dict(self._data["drive"])
+
+    def __eq__(self, other):
+        return isinstance(other, DriveScene) and self._data == other._data
+
+    def __hash__(self):
+        return hash(self.to_toml())
+
+    def __repr__(self):
+        return f"DriveScene({self.title or self.source or 'untitled'!r})"
