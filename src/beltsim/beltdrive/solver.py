@@ -13,6 +13,10 @@ from .discrete import Layout, residual_scale, update_scale
 from .model import LoopMesh, LoopParams, Rates, assemble, max_triplets
 
 
+#: a scaled residual this small is converged whatever the last update (round-off level)
+RESIDUAL_TOL = 1e-12
+
+
 @dataclass
 class System:
     """One discretised drive: the kernel's inputs and the Newton's buffers and scales."""
@@ -95,7 +99,7 @@ def newton(sys_: System, y, rates, rim1, load, tol=1e-10, max_iterations=40):
         y[:] = trial
         _clip_ratios(y, lay, regular)
         merit = new
-        if step == 1.0 and np.max(np.abs(dy) / sys_.yscale) < tol:
+        if step == 1.0 and np.max(np.abs(dy) / sys_.yscale) < tol or merit < RESIDUAL_TOL:
             return it
     raise NumericalError(f"the drive's Newton iteration did not converge in "
                          f"{max_iterations} iterations (scaled residual {merit:.3g})",

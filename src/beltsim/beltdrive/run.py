@@ -1,0 +1,397 @@
+"""Running a closed drive: numerical settings, the steady solve, time steps from rest,
+and the result with its summary and its errors against the analytic steady state."""
+
+from __future__ import annotations
+
+import enum
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import NoSolutionError, NumericalError, SceneError
+from ..problem.drive import Profile, _profile, value
+from .analytic import capacity, solve_string
+from .discrete import (
+    DEFAULT_ELEMENTS,
+    Layout,
+    law_of,
+    layout_of,
+    loop_mesh,
+    loop_params,
+    string_guess,
+)
+from .model import LoopMesh, Rates
+from .scene import DriveParams, DriveScene
+from .solver import System, make_system, newton, steady_rates
+
+#: the summary's figures (the analytic solution gives the same keys)
+SUMMARY_KEYS = ("tight_tension", "slack_tension", "belt_speed", "driven_speed", "speed_ratio",
+                "slip_arc_driver", "slip_arc_driven", "driver_torque", "efficiency",
+                "slip_power")
+
+
+#: the smallest step a Newton failure may halve to, relative to numerics.dt
+MIN_STEP_FRACTION = 1e-4
+
+
+class DriveStatus(enum.Enum):
+    """How a drive's run ended."""
+
+    CONVERGED = "converged"  # steady state reached
+    REACHED_END = "reached t_end"  # t_end reached before a steady state
+    GROSS_SLIP = "gross slip"  # a whole arc slides and the driven pulley slows: physics
+    LIFT_OFF = "lift-off"  # the contact pressure fell to zero: outside this model
+    FAILED = "failed"  # a numerical failure; the state is the last good one
+
+
+@dataclass(frozen=True)
+class DriveNumerics:
+    """A drive scene's numerical settings, every default resolved (:func:`resolve`)."""
+
+    integrator: str
+    elements: int
+    friction_law: str
+    regularisation: float | None
+    ramp_time: float
+    dt: float
+    t_end: float
+    steady_tol: float
+    newton_tol: float
+    newton_max_iterations: int
+
+
+def transit_time(P: DriveParams) -> float:
+    """Lambda / (omega1 R1): how long the belt takes once round the loop (s)."""
+    return P.geometry.loop_length / (P.omega1 * P.geometry.R1)
+
+
+def resolve(scene: DriveScene, elements: int | None = None) -> DriveNumerics:
+    """The scene's numerical settings with their defaults."""
+    P, nm = scene.params, scene.numerics
+    law = law_of(P, nm.get("friction_law"))
+    reg = None
+    if law in ("tanh", "sqrt"):
+        reg = nm.get("regularisation", 1e-3 * P.omega1 * P.geometry.R1 * P.N0 / P.b1)
+    transit = transit_time(P)
+    ramp_time = nm.get("ramp_time", 2.0 * transit)
+    settle = max(ramp_time, _last_table_time(scene))
+    dt = nm.get("dt", ramp_time / 100.0 if ramp_time > 0 else transit / 50.0)
+    t_end = nm.get("t_end", settle + 40.0 * transit)
+    if dt > t_end:
+        raise SceneError("numerics.dt", f"must be <= numerics.t_end = {t_end!r}, got {dt!r}")
+    return DriveNumerics(
+        integrator=nm.get("integrator", "implicit"),
+        elements=elements or nm.get("elements", DEFAULT_ELEMENTS), friction_law=law,
+        regularisation=reg, ramp_time=ramp_time, dt=dt, t_end=t_end,
+        steady_tol=nm.get("steady_tol", 1e-7), newton_tol=nm.get("newton_tol", 1e-10),
+        newton_max_iterations=nm.get("newton_max_iterations", 40))
+
+
+def _last_table_time(scene: DriveScene) -> float:
+    out = 0.0
+    for key in ("driver_speed", "load_torque"):
+        v = scene.drive[key]
+        if isinstance(v, list):
+            out = max(out, v[-1][0])
+    return out
+
+
+def profiles(scene: DriveScene, ramp_time: float) -> tuple[Profile, Profile]:
+    """The driver's rim speed omega1(t) R1 and the load M2(t) as kernel profiles: numbers
+    and sines ramp from 0 over ramp_time, tables are taken as they are."""
+    d = scene.drive
+    R1 = scene.params.geometry.R1
+    return (_profile(d["driver_speed"], 0.0, 1.0 / R1, ramp_time),
+            _profile(d["load_torque"], 0.0, 1.0, ramp_time))
+
+
+class Fields(dict):
+    """Nodal arrays of a drive's state (a dict of name -> array)."""
+
+
+def fields_of(y, lay: Layout, mesh: LoopMesh, P: DriveParams, prm, rim1: float) -> dict:
+    """Nodal fields of the unknowns y: u, theta, N (axial force), f (friction, N/m),
+    p (pressure, N/m), v_rel (m/s), slip (bool), and the friction ratio lam."""
+    u, th = lay.u(y), lay.theta(y)
+    c, w2 = y[lay.c], y[lay.omega2]
+    N = len(mesh.x)
+    # axial force: the upwind three-point strain (as the friction's) at every node
+    idx = (np.arange(N)[:, None] + np.arange(-2, 1)[None, :]) % N
+    eps = np.sum(mesh.sw * u[idx], axis=1)
+    epsb = np.sum(mesh.sw * (u + prm.lever * th)[idx], axis=1)
+    tension = P.N0 + P.b1 * eps
+    on = mesh.lidx >= 0
+    lam = np.zeros(N)
+    lam[on] = lay.lam(y)[mesh.lidx[on]]
+    R = np.where(on, mesh.radius, 1.0)
+    p = np.where(on, (tension - P.rho * c * c) / R, 0.0)
+    S = p * P.mu if P.mu is not None else np.where(on, prm.p_ref, 0.0)
+    f = -S * lam
+    rim = np.where(mesh.arc == 1, w2 * P.geometry.R2, rim1)
+    vrel = np.where(on, c * (1.0 + P.N0 / P.b1 + epsb) - rim, 0.0)
+    slip = on & (np.abs(lam) >= 1.0 - 1e-9) if P.mu is not None else np.zeros(N, bool)
+    return {"u": u.copy(), "theta": th.copy(), "tension": tension, "friction": f,
+            "pressure": p, "slip_velocity": vrel, "slip": slip, "ratio": lam}
+
+
+def _segment_nodes(mesh: LoopMesh, P: DriveParams):
+    """Node indices of each segment's start (entry nodes of the 4 segments)."""
+    return [int(np.argmin(np.abs(mesh.x - b))) for b in P.geometry.bounds[:4]]
+
+
+def span_tensions(u, mesh: LoopMesh, P: DriveParams) -> tuple[float, float]:
+    """Mean axial force over the tight and the slack span: N0 + b1 (u_end - u_start) / l,
+    exact for the nodal values (the integral of the elements' strains)."""
+    k = _segment_nodes(mesh, P)
+    ls = P.geometry.span
+    slack = P.N0 + P.b1 * (u[k[2]] - u[k[1]]) / ls
+    tight = P.N0 + P.b1 * (u[k[0]] - u[k[3]]) / ls
+    return tight, slack
+
+
+def slip_arcs(flds: dict, mesh: LoopMesh, P: DriveParams) -> tuple[float, float]:
+    """The slip arc of each pulley (rad): the sliding nodes' contact lengths, plus the
+    share |lam| of the last sticking node's next to them (the front inside its volume:
+    the node's friction is the integral over its volume, about mu p times the sliding
+    part's length, so a front is located within a cell, not at its nodes)."""
+    out = []
+    for a, R in ((0, P.geometry.R1), (1, P.geometry.R2)):
+        js = np.flatnonzero(mesh.arc == a)
+        slip = flds["slip"][js]
+        length = float(np.sum(mesh.wf[js][slip]))
+        # the last sticking node upstream of the slip run next to the exit
+        prev = (js[slip] - 1) % len(mesh.x)
+        edge = [j for j in prev if mesh.arc[j] == a and not flds["slip"][j]]
+        for j in edge:
+            length += mesh.wf[j] * abs(flds["ratio"][j])
+        out.append(length / R)
+    return out[0], out[1]
+
+
+def summary_of(y, lay, mesh, P, prm, rim1, load, omega1) -> dict:
+    """The summary figures of a state (see SUMMARY_KEYS)."""
+    flds = fields_of(y, lay, mesh, P, prm, rim1)
+    c, w2 = y[lay.c], y[lay.omega2]
+    T1, T2 = span_tensions(flds["u"], mesh, P)
+    F = flds["friction"] * mesh.wf
+    M1 = P.geometry.R1 * float(np.sum(F[mesh.arc == 0]))
+    s1, s2 = slip_arcs(flds, mesh, P)
+    slip_power = float(-np.sum(F * flds["slip_velocity"]))
+    ratio = w2 * P.geometry.R2 / rim1 if rim1 > 0 else math.nan
+    eff = load * w2 / (M1 * omega1) if M1 * omega1 > 0 and load > 0 else math.nan
+    return {"tight_tension": T1, "slack_tension": T2, "belt_speed": c, "driven_speed": w2,
+            "speed_ratio": ratio, "slip_arc_driver": s1, "slip_arc_driven": s2,
+            "driver_torque": M1, "efficiency": eff, "slip_power": slip_power,
+            "driver_power": M1 * omega1, "load_power": load * w2}
+
+
+@dataclass
+class DriveResult:
+    """A drive run's outcome: how it ended, its final state and its history."""
+
+    scene: DriveScene
+    numerics: DriveNumerics
+    status: DriveStatus
+    reason: str | None
+    x: np.ndarray
+    fields: dict
+    summary: dict
+    history: dict = field(default_factory=dict)
+    analytic: object | None = None
+    wall_time: float = 0.0
+    statistics: dict = field(default_factory=dict)
+
+    @property
+    def converged(self) -> bool:
+        """Whether the run reached a steady state."""
+        return self.status is DriveStatus.CONVERGED
+
+    def errors(self) -> dict:
+        """Relative errors of the summary against the analytic steady state (speed loss
+        1 - speed_ratio compared as itself; slip arcs relative to the wrap)."""
+        if self.analytic is None or not self.converged:
+            return {}
+        ex = self.analytic.summary()
+        out = {}
+        for key in ("tight_tension", "slack_tension", "belt_speed", "driven_speed",
+                    "driver_torque", "slip_power"):
+            out[key] = (self.summary[key] - ex[key]) / abs(ex[key]) if ex[key] else \
+                abs(self.summary[key])
+        loss, loss_ex = 1.0 - self.summary["speed_ratio"], 1.0 - ex["speed_ratio"]
+        out["speed_loss"] = (loss - loss_ex) / abs(loss_ex) if loss_ex else abs(loss)
+        wraps = self.scene.params.geometry.wraps
+        out["slip_arc_driver"] = (self.summary["slip_arc_driver"] - ex["slip_arc_driver"]) \
+            / wraps[0]
+        out["slip_arc_driven"] = (self.summary["slip_arc_driven"] - ex["slip_arc_driven"]) \
+            / wraps[1]
+        return out
+
+
+def analytic_of(P: DriveParams):
+    """The analytic steady state the run compares with: the string's creep solution for
+    the string model, the beam's exact solution for the beam (when available)."""
+    if P.model == "beam":
+        try:
+            from .beam import solve_beam
+        except ImportError:  # pragma: no cover - until the beam's solution lands
+            return solve_string(P)
+        return solve_beam(P)
+    return solve_string(P)
+
+
+def _setup(scene, num):
+    P = scene.params
+    mesh = loop_mesh(P.geometry, num.elements)
+    lay = layout_of(mesh)
+    prm = loop_params(P, num.friction_law, num.regularisation)
+    return P, mesh, lay, prm, make_system(mesh, prm, lay, P)
+
+
+def solve_steady(scene: DriveScene, elements: int | None = None) -> DriveResult:
+    """The discrete steady state, by Newton from the string's analytic state.
+
+    Raises
+    ------
+    GrossSlipError, LiftOffError
+        The drive has no steady state (the load exceeds its capacity, or the slack side
+        lifts off).
+    """
+    num = resolve(scene, elements)
+    P, mesh, lay, prm, S = _setup(scene, num)
+    start = time.perf_counter()
+    sol = solve_string(P)
+    y = string_guess(sol, mesh, lay)
+    rim1 = P.omega1 * P.geometry.R1
+    its = newton(S, y, steady_rates(lay.N), rim1, P.M2, num.newton_tol,
+                 num.newton_max_iterations)
+    wall = time.perf_counter() - start
+    flds = fields_of(y, lay, mesh, P, prm, rim1)
+    return DriveResult(scene, num, DriveStatus.CONVERGED, None, mesh.x.copy(), flds,
+                       summary_of(y, lay, mesh, P, prm, rim1, P.M2, P.omega1),
+                       analytic=analytic_of(P), wall_time=wall,
+                       statistics={"newton_iterations": its})
+
+
+def bdf_coefficients(h, h_prev):
+    """(a0, a1, a2) of the variable-step BDF2 derivative y'_n = a0 y_n + a1 y_n-1 +
+    a2 y_n-2; backward Euler (a2 = 0) when h_prev is None."""
+    if h_prev is None:
+        return 1.0 / h, -1.0 / h, 0.0
+    r = h / h_prev
+    return (1.0 + 2.0 * r) / ((1.0 + r) * h), -(1.0 + r) / h, r * r / ((1.0 + r) * h)
+
+
+def simulate(scene: DriveScene, elements: int | None = None, progress=None) -> DriveResult:
+    """Run the drive from rest (c = omega = 0, uniform N0) by BDF2 time steps until the
+    steady state, gross slip, lift-off or t_end."""
+    num = resolve(scene, elements)
+    if num.integrator == "steady":
+        return solve_steady(scene, elements)
+    P, mesh, lay, prm, S = _setup(scene, num)
+    speed, load = profiles(scene, num.ramp_time)
+    R1 = P.geometry.R1
+    settle = max(num.ramp_time, _last_table_time(scene))
+    y = np.zeros(lay.size)
+    nu = 2 * lay.N
+    v_prev = np.zeros(nu)  # rates of (u, theta) at the previous steps
+    y_prev, y_prev2, v_prev2 = y.copy(), None, None
+    h_prev = None
+    t, dt = 0.0, num.dt
+    hist = {k: [] for k in ("t", "omega1", "load_torque", *SUMMARY_KEYS, "driver_power",
+                            "load_power")}
+    status, reason = DriveStatus.REACHED_END, None
+    steps = its_total = rejected = 0
+    start = time.perf_counter()
+    strain = P.N0 / P.b1
+    full_slip_steps = 0
+    while t < num.t_end - 1e-12 * num.t_end:
+        h = min(dt, num.t_end - t)
+        a0, a1, a2 = bdf_coefficients(h, h_prev)
+        hu = a1 * y_prev[:nu] + (a2 * y_prev2[:nu] if y_prev2 is not None else 0.0)
+        hv = a1 * v_prev + (a2 * v_prev2 if v_prev2 is not None else 0.0)
+        hc = a1 * y_prev[lay.c] + (a2 * y_prev2[lay.c] if y_prev2 is not None else 0.0)
+        h2 = a1 * y_prev[lay.omega2] + (a2 * y_prev2[lay.omega2] if y_prev2 is not None
+                                        else 0.0)
+        rates = Rates(a0, np.ascontiguousarray(hu[0::2]), np.ascontiguousarray(hu[1::2]),
+                      np.ascontiguousarray(hv[0::2]), np.ascontiguousarray(hv[1::2]), hc, h2)
+        t_new = t + h
+        rim1 = value(speed, t_new)
+        m2 = value(load, t_new)
+        y_try = y.copy()
+        try:
+            its = newton(S, y_try, rates, rim1, m2, num.newton_tol, num.newton_max_iterations)
+        except NumericalError as exc:
+            # a step the semi-smooth Newton cannot finish is retried at half the size
+            if h > num.dt * MIN_STEP_FRACTION:
+                dt = 0.5 * h
+                rejected += 1
+                continue
+            status, reason = DriveStatus.FAILED, f"t = {t_new:.6g} s: {exc}"
+            break
+        y[:] = y_try
+        dt = min(num.dt, 2.0 * h) if its <= 4 else h
+        its_total += its
+        steps += 1
+        v = a0 * y[:nu] + hu
+        y_prev2, v_prev2 = y_prev, v_prev
+        y_prev, v_prev = y.copy(), v
+        h_prev, t = h, t_new
+        flds = fields_of(y, lay, mesh, P, prm, rim1)
+        on = mesh.lidx >= 0
+        if np.any(flds["pressure"][on] <= 0.0):
+            j = np.flatnonzero(on & (flds["pressure"] <= 0.0))[0]
+            status, reason = DriveStatus.LIFT_OFF, (
+                f"t = {t:.6g} s: the contact pressure fell to zero at x = {mesh.x[j]:.4g} m "
+                f"(the belt lifts off; this model does not describe lift-off)")
+            break
+        sm = summary_of(y, lay, mesh, P, prm, rim1, m2, rim1 / R1)
+        hist["t"].append(t)
+        hist["omega1"].append(rim1 / R1)
+        hist["load_torque"].append(m2)
+        for k in hist:
+            if k in sm:
+                hist[k].append(sm[k])
+        if progress is not None:
+            progress(t, num.t_end)
+        if t < settle:
+            continue
+        # gross slip: a whole arc slides while the driven pulley slows down
+        arcs_slide = [bool(np.all(flds["slip"][mesh.arc == a])) for a in (0, 1)]
+        w2dot = a0 * y[lay.omega2] + h2
+        if any(arcs_slide) and w2dot < 0:
+            full_slip_steps += 1
+            if full_slip_steps >= 5:
+                which = "driver" if arcs_slide[0] else "driven pulley"
+                status, reason = DriveStatus.GROSS_SLIP, (
+                    f"t = {t:.6g} s: the belt slides over the {which}'s whole wrap and the "
+                    f"driven pulley slows down ({y[lay.omega2]:.6g} rad/s)")
+                break
+        else:
+            full_slip_steps = 0
+        cdot = a0 * y[lay.c] + hc
+        rate = max(abs(cdot) / rim1, abs(w2dot) * P.geometry.R2 / rim1,
+                   float(np.max(np.abs(v[0::2]))) / (rim1 * strain))
+        if rate * transit_time(P) < num.steady_tol:
+            status = DriveStatus.CONVERGED
+            break
+    wall = time.perf_counter() - start
+    rim1 = value(speed, t)
+    m2 = value(load, t)
+    flds = fields_of(y, lay, mesh, P, prm, rim1)
+    try:
+        ana = analytic_of(P)
+    except NoSolutionError:
+        ana = None
+    return DriveResult(scene, num, status, reason, mesh.x.copy(), flds,
+                       summary_of(y, lay, mesh, P, prm, rim1, m2, rim1 / R1),
+                       history={k: np.asarray(v) for k, v in hist.items()}, analytic=ana,
+                       wall_time=wall,
+                       statistics={"steps": steps, "newton_iterations": its_total,
+                                   "rejected_steps": rejected})
+
+
+def drive_capacity(scene: DriveScene) -> float:
+    """The string's capacity (N m) at the scene's final driver speed."""
+    return capacity(scene.params)
