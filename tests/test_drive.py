@@ -1,157 +1,265 @@
-"""Drive profiles: tables and sines of the surface speed and the friction limit, their
-validation, the runs they drive, and the slip power."""
+"""The closed belt drive: geometry, scenes, the string's creep solution, the discrete
+steady state's convergence to it, runs from rest, gross slip, the power balance."""
 
 import math
 
 import numpy as np
 import pytest
 
-import beltsim
+from beltsim.beltdrive.analytic import GrossSlipError, capacity, solve_string
+from beltsim.beltdrive.geometry import Geometry
+from beltsim.beltdrive.run import DriveStatus, simulate, solve_steady
+from beltsim.beltdrive.scene import DriveScene
 from beltsim.errors import SceneError
-from beltsim.problem.drive import Profile, drive_of, friction_factor, mismatch, value
-from helpers import ERROR_FACTOR, assert_errors_near, scene_path
-
-COARSE = "numerics.elements=300"
+from helpers import cli, scene_path
 
 
-def _scene(*overrides):
-    return beltsim.load_scene(scene_path("paper_slip"), list(overrides))
+def stick(*overrides):
+    """drive_flat with perfect adhesion (no friction coefficient)."""
+    data = flat(*overrides).to_dict()
+    data["contact"] = {"friction": "stick"}
+    return DriveScene(data)
 
 
-@pytest.mark.unit
-def test_table_value_is_numpys_interpolation_held_at_both_ends():
-    times, vals = np.array([0.01, 0.02, 0.05]), np.array([3.0, -1.0, 2.0])
-    prof = Profile(times, vals, 0.0, 0.0, 0.0, 0.0)
-    for t in np.linspace(-0.01, 0.08, 97):
-        assert value(prof, t) == pytest.approx(np.interp(t, times, vals), abs=1e-15)
+def flat(*overrides):
+    return DriveScene.load(scene_path("drive_flat")).with_overrides(list(overrides))
 
 
-@pytest.mark.unit
-def test_sine_and_number_values():
-    sine = Profile(np.zeros(0), np.zeros(0), 1.5, 0.25, 0.04, 0.0)
-    for t in (0.0, 0.013, 0.5):
-        assert value(sine, t) == pytest.approx(1.5 + 0.25 * math.sin(2 * math.pi * t / 0.04))
-    ramped = Profile.constant(2.0, 0.1)
-    assert value(ramped, 0.0) == 0.0 and value(ramped, 0.1) == 2.0
-    assert value(ramped, 0.05) == pytest.approx(2.0 * 0.5)  # the smoothstep's midpoint
+STRING = ("physics.model", "string")
 
+
+# geometry -------------------------------------------------------------------------
 
 @pytest.mark.unit
-def test_scene_tables_become_the_drive():
-    scene = _scene("motion.surface_speed=[[0.0, 120.0], [0.01, 121.2]]",
-                   "contact.max_friction=[[0.0, 1e6], [0.02, 1e5]]")
-    P = scene.params
-    assert P.v == 121.2 and P.fstar == 1e5  # the final values
-    d = drive_of(scene, ramp_time=0.5)  # a table is not ramped
-    assert mismatch(d, 0.005) == pytest.approx(0.6)
-    assert friction_factor(d, 0.0) == pytest.approx(10.0)
-    assert friction_factor(d, 0.01) == pytest.approx(5.5)
-    assert friction_factor(d, 1.0) == pytest.approx(1.0)
-    # written back and read again unchanged (scene.toml beside a run)
-    import tomllib
-    assert beltsim.Scene(tomllib.loads(scene.to_toml())).to_dict() == scene.to_dict()
+@pytest.mark.parametrize("r1, r2, c", [(0.08, 0.16, 0.6), (0.2, 0.05, 0.5), (0.1, 0.1, 0.3)])
+def test_geometry_closes_the_loop(r1, r2, c):
+    g = Geometry(r1, r2, c)
+    phi1, phi2 = g.wraps
+    assert phi1 + phi2 == pytest.approx(2 * math.pi, rel=1e-15)
+    # the spans are the pulleys' outer tangents: by Pythagoras on the centre line
+    assert g.span == pytest.approx(math.sqrt(c * c - (r2 - r1) ** 2), rel=1e-14)
+    x = np.linspace(0.0, g.loop_length, 400001)
+    X, Y = g.path(x)
+    steps = np.hypot(np.diff(X), np.diff(Y))
+    # the path is continuous and runs at unit speed in x (a chord's deficit is O(dx^2/R))
+    assert steps.sum() == pytest.approx(g.loop_length, rel=1e-9)
+    assert np.max(np.abs(steps / np.diff(x) - 1.0)) < 1e-8
+    # arcs on their rims
+    on1 = g.segment_of(x) == 0
+    assert np.allclose(np.hypot(X[on1], Y[on1]), r1, rtol=1e-12)
+    on2 = g.segment_of(x) == 2
+    assert np.allclose(np.hypot(X[on2] - c, Y[on2]), r2, rtol=1e-12)
 
+
+# scenes ---------------------------------------------------------------------------
 
 @pytest.mark.unit
-@pytest.mark.parametrize("override, message", [
-    ("motion.surface_speed=[]", "motion.surface_speed: a table needs at least one"),
-    ("motion.surface_speed=[[0, 120], [0, 121]]", "row 2: times must increase strictly"),
-    ("motion.surface_speed=[[0, 120], 3]", "row 2: must be a [time, value] pair"),
-    ("motion.surface_speed=[[0, true]]", "row 1 value: must be a number"),
-    ("motion.surface_speed=[[0, inf]]", "row 1 value: must be finite"),
-    ("motion.surface_speed=[[0, -1]]", "row 1 value: must be > 0"),
-    ("motion.surface_speed=[[0, 120], [1, 200]]", "below both critical speeds"),
-    ("motion.surface_speed={mean=121, amplitude=1, period=0}", "period: must be > 0"),
-    ("motion.surface_speed={mean=121, amplitude=1, period=1, phase=0}",
-     "motion.surface_speed.phase: unknown key of a sine"),
-    ("contact.max_friction=[[0, 1e5], [1, -1e5]]", "contact.max_friction row 2 value"),
-    ("contact.max_friction={mean=1e5, amplitude=1e5, period=1}", "must stay > 0"),
+@pytest.mark.parametrize("override, key, rule", [
+    (("drive.centre_distance", 0.2), "drive.centre_distance", "overlap"),
+    (("drive.driver_radius", -1.0), "drive.driver_radius", "> 0"),
+    (("drive.load_torque", -5.0), "drive.load_torque", ">= 0"),
+    (("drive.load_torque", [[0.0, 1.0], [0.0, 2.0]]), "drive.load_torque row 2",
+     "increase"),
+    (("drive.driver_speed", 0.0), "drive.driver_speed", "> 0"),
+    (("drive.driver_speed", 9000.0), "drive.driver_speed", "critical speed"),
+    (("drive.installation_tension", 5.0), "drive.installation_tension", "lift"),
+    (("contact.friction", "stick"), "contact.friction_coefficient", "only for"),
+    (("contact.friction", "sliding"), "contact.friction", "one of"),
+    (("physics.model", "plate"), "physics.model", "one of"),
+    (("numerics.regularisation", 1e-4), "numerics.regularisation", "regularised"),
+    (("numerics.elements", 8), "numerics.elements", ">= 16"),
+    (("drive.pulleys", 2), "drive.pulleys", "unknown key"),
 ])
-def test_profile_rules_name_key_row_and_rule(override, message):
-    with pytest.raises(SceneError, match=None) as info:
-        _scene(override)
-    assert message in str(info.value) and "\n" not in str(info.value)
+def test_bad_drive_scenes_name_the_key_and_the_rule(override, key, rule):
+    with pytest.raises(SceneError) as info:
+        flat(override)
+    msg = str(info.value)
+    assert key in msg and rule in msg and "\n" not in msg
 
 
 @pytest.mark.unit
-def test_two_sines_must_share_their_period():
-    with pytest.raises(SceneError, match="must equal motion.surface_speed.period"):
-        _scene("motion.surface_speed={mean=121.2, amplitude=0.1, period=0.02}",
-               "contact.max_friction={mean=1e5, amplitude=1e4, period=0.03}")
+def test_a_drive_scene_keeps_its_own_sections():
+    data = flat().to_dict()
+    data["beam"] = {"length": 1.0}
+    with pytest.raises(SceneError, match=r"\[beam\].*not in a closed drive"):
+        DriveScene(data)
+    data = flat().to_dict()
+    del data["drive"]["driven_inertia"]
+    with pytest.raises(SceneError, match="drive.driven_inertia: missing key"):
+        DriveScene(data)
+    again = DriveScene.loads(flat().to_toml())
+    assert again == flat()
 
 
-@pytest.mark.verification
-def test_a_table_ending_at_the_constant_value_reaches_the_same_state():
-    """A start-up written as a table (linear, 2 transit times) against the default
-    smoothstep ramp: both end on the same steady state, to the steady tolerance."""
-    const = beltsim.run(_scene(COARSE))
-    table = beltsim.run(_scene(COARSE, "motion.surface_speed=[[0, 120], [0.0167, 121.2]]"))
-    assert const.converged and table.converged
-    F = const.solution.total_friction
-    assert abs(table.solution.total_friction - F) / abs(F) < 1e-5
-    assert np.max(np.abs(table.solution.u - const.solution.u)) < 1e-5 * np.max(
-        np.abs(const.solution.u))
-    # the steady test starts after the last row
-    assert table.simulated_time > 0.0167
+# the string's creep solution, checked by quadrature and differentiation -------------
 
-
-@pytest.mark.verification
-def test_a_drop_of_the_friction_limit_ends_on_the_analytic_state_of_the_final_limit():
-    """f* from 1e6 to 1e5 N/m after the start-up: the creep zone grows to the f* = 1e5
-    state, which the run meets to the discretisation error of its grid (300 elements,
-    second order: measured below; slip start in m)."""
-    res = beltsim.run(_scene(COARSE, "contact.max_friction=[[0.05, 1e6], [0.0501, 1e5]]"))
-    assert_errors_near(res, {"total_friction": 4.6e-5, "u": 3.9e-5, "theta": 1.3e-4,
-                             "slip_power": 4.7e-5, "slip_start": 2.8e-6})
-    # the history shows the short slip zone of f* = 1e6 before the drop
-    h = res.history
-    before = h["slip_start"][h["t"] <= 0.05][-1]
-    assert before > res.reference.x_star + 0.02
-
-
-@pytest.mark.verification
-@pytest.mark.parametrize("speed, measured, law", [(121.2, 7.4e-6, 4.7e-4),
-                                                  (119.9, 1.4e-5, 0.12)])
-def test_slip_power_matches_the_analytic_value(speed, measured, law):
-    """The summary's slip power (steady energy balance) on the default grid (600
-    elements), paper slip and a reversed scene (v < c): measured 7.4e-6 and 1.4e-5,
-    about second order in the element size (1200 elements: 1.8e-6 and 4.5e-6)."""
-    res = beltsim.run(_scene(f"motion.surface_speed={speed}", "numerics.integrator=steady"))
-    assert res.errors()["slip_power"] < ERROR_FACTOR * measured
-    # the friction law's own dissipation is the same power, with a larger error on this
-    # grid: measured 4.7e-4 and 0.12 (1200 elements: 1.2e-4 and 2.1e-2); bound 2x
-    sol = res.solution
-    assert abs(sol.slip_power - res.reference.slip_power) < 2 * law * res.reference.slip_power
+@pytest.mark.unit
+@pytest.mark.parametrize("inertia", [True, False])
+def test_string_solution_satisfies_its_equations(inertia):
+    P = flat(STRING, ("physics.inertia", inertia)).params
+    sol = solve_string(P)
+    g = P.geometry
+    kappa = 1.0 - P.rho * sol.c**2 / P.b1
+    x = np.linspace(0.0, g.loop_length, 2_000_001)[:-1]
+    N, f = sol.tension(x), sol.friction(x)
+    # the belt's length: mean N over the loop is N0 (quadrature error ~ jumps * dx)
+    assert np.mean(N) == pytest.approx(P.N0, rel=1e-6)
+    # kappa N' + f = 0 away from the slip fronts (central differences, error O(dx^2))
+    dx = x[1] - x[0]
+    dN = (N[2:] - N[:-2]) / (2 * dx)
+    far = np.ones(len(dN), bool)
+    for b in list(g.bounds) + list(sol.stick_ends):
+        far &= np.abs(x[1:-1] - b) > 3 * dx
+    assert np.max(np.abs(kappa * dN + f[1:-1])[far]) < 1e-4 * np.max(np.abs(f))
+    # the driven pulley's balance and the driver's torque, by quadrature of f
+    on2 = g.segment_of(x) == 2
+    on1 = g.segment_of(x) == 0
+    assert -g.R2 * np.sum(f[on2]) * dx == pytest.approx(P.M2, rel=1e-5)
+    assert g.R1 * np.sum(f[on1]) * dx == pytest.approx(sol.driver_torque, rel=1e-5)
+    # adhesion at each arc's entry: the material moves with the rim
+    assert sol.c * (1 + sol.T1 / P.b1) == pytest.approx(P.omega1 * g.R1, rel=1e-14)
+    assert sol.c * (1 + sol.T2 / P.b1) == pytest.approx(sol.omega2 * g.R2, rel=1e-14)
+    # the slip power is the friction's dissipation -integral f v_rel
+    rim = np.where(on1, P.omega1 * g.R1, sol.omega2 * g.R2)
+    vrel = sol.c * (1 + N / P.b1) - rim
+    dissipated = -np.sum((f * vrel)[on1 | on2]) * dx
+    assert dissipated == pytest.approx(sol.slip_power, rel=1e-5)
+    # and the power balance M1 omega1 = M2 omega2 + slip power holds exactly
+    assert sol.driver_torque * P.omega1 == pytest.approx(
+        P.M2 * sol.omega2 + sol.slip_power, rel=1e-13)
+    # the displacement's slope is the strain (N - N0) / b1, its mean is zero
+    u = sol.displacement(x[::1000])
+    assert abs(np.mean(sol.displacement(x[::100]))) < 1e-9 * np.max(np.abs(u))
 
 
 @pytest.mark.unit
-def test_history_slip_power_is_the_kernels_slip_term():
-    """The numpy reading of the history agrees with physics.model.power_terms."""
-    from beltsim.physics.model import POWER_TERMS, power_terms
-    from beltsim.simulation.controller import Simulation
+def test_string_adhesion_closed_form():
+    """Quasistatic perfect adhesion: T1 (l + R1 phi1) + T2 (l + R2 phi2) = N0 Lambda with
+    T1 - T2 = M2 / R2, solved by hand."""
+    P = stick(STRING, ("physics.inertia", False)).params
+    g = P.geometry
+    dT = P.M2 / g.R2
+    a1, a2 = g.span + g.arcs[0], g.span + g.arcs[1]
+    T1 = (P.N0 * g.loop_length + dT * a2) / (a1 + a2)
+    sol = solve_string(P)
+    assert sol.T1 == pytest.approx(T1, rel=1e-13)
+    assert sol.T2 == pytest.approx(T1 - dT, rel=1e-13)
+    assert sol.phi_s == 0.0 and sol.concentrated[0] == pytest.approx(dT, rel=1e-13)
 
-    sim = Simulation(_scene(COARSE, "numerics.t_end=0.02"))
-    sim.run()
-    out = np.zeros(len(POWER_TERMS))
-    d = sim.disc
-    power_terms(sim.state, sim.t, d.mesh, d.model, d.drive, d.loads, out)
-    assert sim.solution().slip_power == pytest.approx(out[POWER_TERMS.index("slip")],
-                                                      rel=1e-12)
+
+@pytest.mark.unit
+def test_capacity_is_where_the_slip_arc_covers_the_wrap():
+    P = flat(STRING).params
+    cap = capacity(P)
+    phi1 = min(P.geometry.wraps)
+    below = solve_string(P, M2=cap * (1 - 1e-9))
+    assert below.phi_s == pytest.approx(phi1, rel=1e-6)
+    # the Euler-Eytelwein ratio with the centrifugal term and kappa
+    rc = P.rho * below.c**2
+    assert (below.T1 - rc) / (below.T2 - rc) == pytest.approx(
+        math.exp(P.mu * phi1 / below.kappa), rel=1e-6)
+    with pytest.raises(GrossSlipError, match="exceeds the drive's capacity") as info:
+        solve_string(P, M2=cap * 1.001)
+    assert info.value.capacity == pytest.approx(cap)
+
+
+# the discrete steady state against the string's -------------------------------------
+
+#: errors measured on the default scene (string model): 400, 800, 1600 elements
+@pytest.mark.verification
+def test_steady_string_converges_at_second_order():
+    scene = flat(STRING)
+    ladder = (200, 400, 800, 1600)
+    keys = ("tight_tension", "slack_tension", "speed_loss", "slip_arc_driver",
+            "slip_arc_driven")
+    errs = {k: [] for k in keys}
+    for n in ladder:
+        r = solve_steady(scene, n)
+        e = r.errors()
+        for k in keys:
+            errs[k].append(abs(e[k]))
+    h = 1.0 / np.array(ladder)
+    for k in keys:
+        order = np.polyfit(np.log(h), np.log(errs[k]), 1)[0]
+        assert order >= 1.8, (k, errs[k], order)
+    # on the default grid (800): tensions within 1e-4, speed loss within 1e-3 (relative),
+    # measured 1.3e-6, 2.1e-6 and 8.1e-9
+    r = solve_steady(scene)
+    e = r.errors()
+    assert abs(e["tight_tension"]) < 1e-5 and abs(e["slack_tension"]) < 1e-5
+    assert abs(e["speed_loss"]) < 1e-7
 
 
 @pytest.mark.verification
-def test_periodic_drive_stops_at_its_periodic_state_and_reports_the_last_period():
-    """A sine of the surface speed: the run ends when two periods agree within the
-    steady tolerance, and the summary gives the last period's extremes and means."""
-    res = beltsim.run(_scene(COARSE, "motion.surface_speed={mean=121.2, amplitude=0.3, "
-                             "period=0.02}"), raise_on_failure=False)
-    assert res.converged, res.reason
-    per = res.summary()["periodic"]
-    assert per["period"] == 0.02 and per["change"] < 1e-6
-    tf, xs = per["total_friction"], per["slip_start"]
-    assert tf["min"] < tf["mean"] < tf["max"] and xs["min"] < xs["max"]
-    # the friction breathes with the speed: at the mean speed the analytic total lies
-    # inside the period's range
-    ref = beltsim.solve(_scene())
-    assert tf["min"] < ref.total_friction < tf["max"]
-    assert res.reference is None  # a periodic drive has no steady state to compare
+def test_steady_power_balance_and_torques():
+    r = solve_steady(flat(STRING), 800)
+    s = r.summary
+    P = r.scene.params
+    # the discrete balance closes to the discretisation error (measured 5.9e-7)
+    assert abs(s["driver_power"] - s["load_power"] - s["slip_power"]) < 3e-6 * s[
+        "driver_power"]
+    # the driver's torque is R1/R2 of the load at steady state (kappa dT on both arcs)
+    assert s["driver_torque"] == pytest.approx(P.M2 * P.geometry.R1 / P.geometry.R2,
+                                               rel=1e-8)
+
+
+# runs from rest --------------------------------------------------------------------
+
+@pytest.mark.verification
+def test_start_up_from_rest_ends_on_the_analytic_state():
+    r = simulate(flat(STRING))
+    assert r.status is DriveStatus.CONVERGED
+    e = r.errors()
+    # measured on 800 elements: tensions 1.3e-6, 2.1e-6; speed loss 7.0e-7; slip arcs
+    # 1.2e-5, 1.4e-5 of the wrap (the steady tolerance adds to the grid's error)
+    assert abs(e["tight_tension"]) < 5e-6 and abs(e["slack_tension"]) < 7e-6
+    assert abs(e["speed_loss"]) < 3e-6
+    assert abs(e["slip_arc_driver"]) < 5e-5 and abs(e["slip_arc_driven"]) < 5e-5
+    # the history starts at rest and follows the ramp
+    assert r.history["belt_speed"][0] < 0.05 * r.summary["belt_speed"]
+
+
+@pytest.mark.verification
+def test_load_step_ends_on_the_new_loads_state():
+    scene = flat(STRING, ("drive.load_torque", [[0.0, 0.0], [0.3, 30.0], [0.6, 30.0],
+                                                [0.61, 60.0]]))
+    r = simulate(scene)
+    assert r.status is DriveStatus.CONVERGED
+    ex = solve_string(scene.params, M2=60.0)
+    assert r.summary["tight_tension"] == pytest.approx(ex.T1, rel=1e-5)
+    assert 1 - r.summary["speed_ratio"] == pytest.approx(1 - ex.speed_ratio, rel=1e-5)
+    # the history passes through the 30 N m state before the step
+    t = r.history["t"]
+    before = np.argmin(np.abs(t - 0.6))
+    ex30 = solve_string(scene.params, M2=30.0)
+    assert r.history["tight_tension"][before] == pytest.approx(ex30.T1, rel=1e-3)
+
+
+@pytest.mark.verification
+def test_gross_slip_threshold():
+    P = flat(STRING).params
+    cap = capacity(P)
+    above = simulate(flat(STRING, ("drive.load_torque", 1.05 * cap)))
+    assert above.status is DriveStatus.GROSS_SLIP and "whole wrap" in above.reason
+    below = simulate(flat(STRING, ("drive.load_torque", 0.95 * cap)))
+    assert below.status is DriveStatus.CONVERGED
+    assert below.summary["slip_arc_driver"] == pytest.approx(
+        solve_string(P, M2=0.95 * cap).phi_s, rel=1e-3)
+    with pytest.raises(GrossSlipError):
+        solve_steady(flat(STRING, ("drive.load_torque", 1.05 * cap)))
+
+
+# the command line ------------------------------------------------------------------
+
+@pytest.mark.cli
+def test_cli_runs_and_refuses_drives(tmp_path):
+    res = cli("analytic", "drive_flat", "--set", "physics.model=string", "--out",
+              tmp_path / "a")
+    assert res.returncode == 0, res.stderr
+    assert "slip_arc_driver" in res.stdout
+    res = cli("run", "drive_flat", "--set", "drive.centre_distance=0.1", "--out",
+              tmp_path / "b")
+    assert res.returncode == 2 and res.stderr.count("\n") == 1
+    assert "drive.centre_distance" in res.stderr
+    res = cli("sweep", "drive_flat", "--vary", "drive.load_torque=1,2")
+    assert res.returncode == 2 and "closed drive" in res.stderr

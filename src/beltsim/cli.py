@@ -31,6 +31,62 @@ def _scene(args):
     return load_scene(args.scene, args.overrides)
 
 
+def _is_drive(scene) -> bool:
+    from .beltdrive.scene import DriveScene
+    return isinstance(scene, DriveScene)
+
+
+def _straight_only(args, scene):
+    """Refuse, in one line, a closed drive in a command that knows only straight belts."""
+    if _is_drive(scene):
+        raise UsageError(f"{args.command}: not available for a closed drive yet (use "
+                         f"'beltsim run' or 'beltsim analytic')")
+    return scene
+
+
+def _drive_analytic(args, scene):
+    from .beltdrive.analytic import solve_string
+    from .beltdrive.io import format_drive
+    from .beltdrive.run import analytic_of
+    from .io.files import prepare_outdir, write_json
+
+    out = prepare_outdir(args.out)
+    summaries = {"string": solve_string(scene.params).summary()}
+    if scene.params.model == "beam":
+        summaries["beam"] = analytic_of(scene.params).summary()
+    write_json(out / "summary.json", summaries)
+    for name, summary in summaries.items():
+        print(format_drive(summary, title=f"{scene.title or args.scene} ({name})"))
+    print(f"wrote {out / 'summary.json'}")
+    return 0
+
+
+def _drive_run(args, scene):
+    from pathlib import Path
+
+    from .beltdrive.io import format_drive, result_summary, save_drive_run
+    from .beltdrive.run import DriveStatus, simulate
+
+    out = Path(args.out or Path("runs/out") / Path(args.scene).stem)
+    result = simulate(scene)
+    save_drive_run(result, out)
+    summary = result_summary(result)
+    print(format_drive(summary, title=scene.title or args.scene))
+    print(f"  status           {summary['status']} after {summary.get('steps', 0)} steps, "
+          f"wall {summary['wall_time']:.3g} s")
+    if summary["error"]:
+        print("  error vs exact   " + ", ".join(f"{k} {v:.2e}" for k, v in
+                                              summary["error"].items()))
+    print(f"wrote {out}/summary.json, fields.csv, history.csv")
+    if result.status is DriveStatus.FAILED:
+        print(f"beltsim: numerical failure: {result.reason}", file=sys.stderr)
+        return 3
+    if result.status is not DriveStatus.CONVERGED:
+        print(f"beltsim: {result.status.value}: {result.reason}", file=sys.stderr)
+        return 1
+    return 0
+
+
 def _progress(args) -> bool:
     """A progress bar unless --quiet, and only on a terminal: not in a captured log."""
     return not args.quiet and sys.stderr.isatty()
@@ -46,6 +102,8 @@ def cmd_analytic(args):
     from .problem import analytic
 
     scene = _scene(args)
+    if _is_drive(scene):
+        return _drive_analytic(args, scene)
     sol = analytic.solve(scene)
     out = prepare_outdir(args.out)
     x, fields = sol.sample()
@@ -92,6 +150,8 @@ def cmd_run(args):
         if not args.scene:
             raise UsageError("run: give a SCENE file, or --resume DIR")
         scene = _scene(args)
+        if _is_drive(scene):
+            return _drive_run(args, scene)
         sim = Simulation(scene, snapshot_interval=args.snapshots)
         out = prepare_outdir(args.out or Path("runs/out") / Path(args.scene).stem)
         title = scene.title or args.scene
@@ -145,7 +205,7 @@ def cmd_convergence(args):
     from .plots.studies import ERROR_VS_RUNTIME_DPI, error_vs_runtime
     from .studies import convergence as studies
 
-    scene = _scene(args)
+    scene = _straight_only(args, _scene(args))
     ladder = _int_list(args.ladder, "--ladder")
     schemes = args.schemes.split(",") if args.schemes else None
     known = (*solvers.names(), studies.RICHARDSON)
@@ -182,7 +242,7 @@ def cmd_bench(args):
     from .studies import bench as studies
 
     grid = [("numerics.elements", args.elements)] if args.elements is not None else []
-    scene = load_scene(args.scene, [*args.overrides, *grid])
+    scene = _straight_only(args, load_scene(args.scene, [*args.overrides, *grid]))
     result = studies.bench(scene, cold=not args.no_cold, repeat=args.repeat)
     print(studies.bench_json(result))
     return 0
@@ -229,7 +289,7 @@ def cmd_sweep(args):
     from .plots.studies import CREEP_COLLAPSE_DPI, creep_collapse
     from .studies import sweep
 
-    scene = _scene(args)
+    scene = _straight_only(args, _scene(args))
     key, values = sweep.parse_vary(args.vary)
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers: must be >= 1, got {args.workers}")
@@ -295,7 +355,7 @@ def cmd_animate(args):
     else:
         if not args.scene:
             raise UsageError("animate: give a SCENE file, or --from DIR")
-        scene = _scene(args)
+        scene = _straight_only(args, _scene(args))
         P = scene.params
         interval = args.interval or scene.numerics.get("snapshot_interval") or P.L / (4 * P.c)
         if not interval > 0:

@@ -118,7 +118,6 @@ class StringSolution:
         P, g = self.P, self.P.geometry
         x = np.mod(np.asarray(x, dtype=float), g.loop_length)
         seg = g.segment_of(x)
-        e = g.bounds
         out = np.where((seg == 1), self.T2, self.T1)
         out = np.where(seg == 2, self.T2, out)
         if P.mu is not None:
@@ -168,8 +167,22 @@ class StringSolution:
         xs, w = _gauss_nodes(self._breakpoints())
         mean = np.sum(w * (lam - xs) * (self.tension(xs) - self.P.N0)) / (self.P.b1 * lam)
         x = np.mod(np.asarray(x, dtype=float), lam)
-        u = np.array([_integral(self, 0.0, xi) for xi in np.ravel(x)]).reshape(np.shape(x))
-        return u - mean
+        return self._antiderivative(x) - mean
+
+    def _antiderivative(self, x) -> np.ndarray:
+        """The integral of (N - N0) / b1 from 0 to x (each piece's exact integral, by
+        Gauss-Legendre on the piece's part below x: N is smooth within a piece)."""
+        br = self._breakpoints()
+        xg, wg = _GAUSS
+        flat = np.ravel(x)
+        out = np.zeros_like(flat)
+        for a, b in zip(br[:-1], br[1:]):
+            hi = np.clip(flat, a, b)
+            # nodes on [a, hi] for every x at once: (points, 24)
+            pts = a + (hi - a)[:, None] * 0.5 * (xg[None, :] + 1.0)
+            vals = self.tension(pts.ravel()).reshape(pts.shape) - self.P.N0
+            out += 0.5 * (hi - a) * (vals @ wg)
+        return out.reshape(np.shape(x)) / self.P.b1
 
     def _breakpoints(self) -> np.ndarray:
         pts = list(self.P.geometry.bounds)
@@ -189,16 +202,6 @@ def _gauss_nodes(breaks):
         xs.append(0.5 * (b - a) * xg + 0.5 * (a + b))
         ws.append(0.5 * (b - a) * wg)
     return np.concatenate(xs), np.concatenate(ws)
-
-
-def _integral(sol: StringSolution, a: float, b: float) -> float:
-    """Integral of (N - N0) / b1 over [a, b] (the pieces are smooth: exact to round-off)."""
-    br = sol._breakpoints()
-    pts = np.unique(np.concatenate([[a, b], br[(br > a) & (br < b)]]))
-    if len(pts) < 2:
-        return 0.0
-    xs, w = _gauss_nodes(pts)
-    return float(np.sum(w * (sol.tension(xs) - sol.P.N0)) / sol.P.b1)
 
 
 def _state(P: DriveParams, omega1: float, M2: float, T1: float):
@@ -227,12 +230,12 @@ def _closure(P: DriveParams, c, kappa, T1, T2, phi_s) -> float:
     return out - P.N0 * g.loop_length
 
 
-def _bracket(fun, lo, hi_start):
+def _bracket(fun, hi_start):
     hi = hi_start
     for _ in range(200):
         if fun(hi) > 0:
             return hi
-        lo, hi = hi, 2.0 * hi
+        hi = 2.0 * hi
     raise NoSolutionError("no bracket for the drive's steady tension")
 
 
@@ -258,7 +261,11 @@ def capacity(P: DriveParams, omega1: float | None = None) -> float:
         return _closure(P, c, kappa, T1, T1 - dT, phi_min)
 
     lo = P.rho * (omega1 * R1) ** 2
-    hi = _bracket(resid, lo, max(2.0 * P.N0, 2.0 * lo, 1.0))
+    if not resid(lo) < 0:
+        raise LiftOffError(f"drive.installation_tension: {P.N0:g} N leaves the belt without "
+                           f"contact pressure (it lifts off) even unloaded at {omega1:g} rad/s (the "
+                           f"centrifugal tension rho c^2 is about {lo:.4g} N)")
+    hi = _bracket(resid, max(2.0 * P.N0, 2.0 * lo, 1.0))
     T1 = brentq(resid, lo, hi, xtol=1e-13 * hi, rtol=1e-15, maxiter=200)
     c, kappa, dT = parts(T1)
     return R2 * kappa * dT
@@ -289,13 +296,13 @@ def solve_string(P: DriveParams, omega1: float | None = None,
         return _closure(P, c, kappa, T1, T2, _slip_arc(P, c, kappa, T1, T2))
 
     # margin grows with T1 (c falls): below its root the slack side has no pressure
-    top = _bracket(margin, 0.0, max(2.0 * P.N0, P.rho * rim * rim, 1.0))
+    top = _bracket(margin, max(2.0 * P.N0, P.rho * rim * rim, 1.0))
     lo = brentq(margin, 0.0, top, xtol=1e-14 * top) if margin(0.0) < 0 else 0.0
     lo_t = lo * (1 + 1e-12) + 1e-300
-    if P.mu is None and resid(lo_t) >= 0:
+    if not resid(lo_t) < 0:
         raise LiftOffError(f"drive.installation_tension: {P.N0:g} N leaves the slack span "
                            f"without contact pressure at this load and speed")
-    hi = _bracket(resid, lo_t, max(2.0 * lo_t, 2.0 * P.N0 + M2 / P.geometry.R2, 1.0))
+    hi = _bracket(resid, max(2.0 * lo_t, 2.0 * P.N0 + M2 / P.geometry.R2, 1.0))
     T1 = brentq(resid, lo_t, hi, xtol=1e-14 * hi, rtol=1e-15, maxiter=300)
     c, kappa, dT, T2 = _state(P, omega1, M2, T1)
     phi_s = _slip_arc(P, c, kappa, T1, T2)

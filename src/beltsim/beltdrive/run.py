@@ -24,7 +24,7 @@ from .discrete import (
 )
 from .model import LoopMesh, Rates
 from .scene import DriveParams, DriveScene
-from .solver import System, make_system, newton, steady_rates
+from .solver import make_system, newton, steady_rates
 
 #: the summary's figures (the analytic solution gives the same keys)
 SUMMARY_KEYS = ("tight_tension", "slack_tension", "belt_speed", "driven_speed", "speed_ratio",
@@ -34,6 +34,8 @@ SUMMARY_KEYS = ("tight_tension", "slack_tension", "belt_speed", "driven_speed", 
 
 #: the smallest step a Newton failure may halve to, relative to numerics.dt
 MIN_STEP_FRACTION = 1e-4
+#: steps in a row with a whole arc sliding and the driven pulley slowing: gross slip
+GROSS_SLIP_STEPS = 3
 
 
 class DriveStatus(enum.Enum):
@@ -355,21 +357,18 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None) -> D
                 hist[k].append(sm[k])
         if progress is not None:
             progress(t, num.t_end)
-        if t < settle:
-            continue
-        # gross slip: a whole arc slides while the driven pulley slows down
+        # gross slip: a whole arc slides while the driven pulley slows down (the load wins)
         arcs_slide = [bool(np.all(flds["slip"][mesh.arc == a])) for a in (0, 1)]
         w2dot = a0 * y[lay.omega2] + h2
-        if any(arcs_slide) and w2dot < 0:
-            full_slip_steps += 1
-            if full_slip_steps >= 5:
-                which = "driver" if arcs_slide[0] else "driven pulley"
-                status, reason = DriveStatus.GROSS_SLIP, (
-                    f"t = {t:.6g} s: the belt slides over the {which}'s whole wrap and the "
-                    f"driven pulley slows down ({y[lay.omega2]:.6g} rad/s)")
-                break
-        else:
-            full_slip_steps = 0
+        full_slip_steps = full_slip_steps + 1 if any(arcs_slide) and w2dot < 0 else 0
+        if full_slip_steps >= GROSS_SLIP_STEPS:
+            which = "driver" if arcs_slide[0] else "driven pulley"
+            status, reason = DriveStatus.GROSS_SLIP, (
+                f"t = {t:.6g} s: the belt slides over the {which}'s whole wrap and the "
+                f"driven pulley slows down ({y[lay.omega2]:.6g} rad/s)")
+            break
+        if t < settle:
+            continue
         cdot = a0 * y[lay.c] + hc
         rate = max(abs(cdot) / rim1, abs(w2dot) * P.geometry.R2 / rim1,
                    float(np.max(np.abs(v[0::2]))) / (rim1 * strain))

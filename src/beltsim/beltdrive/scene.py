@@ -25,13 +25,13 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import SceneError
+from ..errors import NoSolutionError, SceneError
 from ..problem.scene import (
     _RETIRED,
     POS,
     PROFILE,
-    _Rule,
     _number,
+    _Rule,
     _show,
     _toml_value,
     final_value,
@@ -215,6 +215,14 @@ def validate(data: dict) -> dict:
     if P.rho > 0 and max_rim_speed(out) ** 2 * P.rho >= P.b1:
         raise SceneError("drive.driver_speed", f"the rim speed reaches the belt's critical "
                          f"speed sqrt(b1 / rho) = {math.sqrt(P.b1 / P.rho):.4g} m/s")
+    from .analytic import LiftOffError, solve_string
+
+    try:
+        solve_string(P)
+    except LiftOffError as exc:
+        raise SceneError(str(exc)) from None
+    except NoSolutionError:
+        pass  # gross slip is a run's physical outcome; the steady solve refuses it
     return out
 
 

@@ -12,7 +12,6 @@ from ..errors import FailureKind, NumericalError
 from .discrete import Layout, residual_scale, update_scale
 from .model import LoopMesh, LoopParams, Rates, assemble, max_triplets
 
-
 #: a scaled residual this small is converged whatever the last update (round-off level)
 RESIDUAL_TOL = 1e-12
 

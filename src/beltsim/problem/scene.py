@@ -250,6 +250,9 @@ def validate(data: dict) -> dict:
     if not isinstance(data, dict):
         raise SceneError("scene: must be a TOML table")
     out: dict = {}
+    if "drive" in data:
+        raise SceneError("[drive]", "a closed drive: read it with beltsim.load_scene or "
+                         "beltsim.beltdrive.scene.DriveScene")
     for key, value in data.items():
         if key in SCHEMA:
             if not isinstance(value, dict):
@@ -879,8 +882,19 @@ def shipped_scene(name: str, overrides=()) -> Scene:
         known = ", ".join(scene_names()) or "none installed"
         raise MissingInputError(f"{name}: no scene of that name ships with beltsim "
                                 f"(shipped: {known})")
-    scene = Scene.loads(resource.read_text(encoding="utf-8"), source=name)
+    scene = _loads_any(resource.read_text(encoding="utf-8"), source=name)
     return scene.with_overrides(overrides) if overrides else scene
+
+
+def _loads_any(text: str, source: str):
+    """A Scene, or a DriveScene where the text has a [drive] section (a closed drive)."""
+    from ..beltdrive.scene import DriveScene, is_drive
+
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{source or 'scene'}: malformed TOML ({exc})") from None
+    return DriveScene(data, source=source) if is_drive(data) else Scene(data, source=source)
 
 
 def load_scene(path_or_name, overrides=()) -> Scene:
@@ -894,7 +908,12 @@ def load_scene(path_or_name, overrides=()) -> Scene:
     if not Path(text).exists() and "/" not in text and "\\" not in text \
             and not text.endswith(".toml"):
         return shipped_scene(text, overrides)
-    scene = Scene.load(path_or_name)
+    path = Path(path_or_name)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except (OSError, UnicodeDecodeError):
+        return Scene.load(path)  # its one-line messages for missing and unreadable files
+    scene = _loads_any(text, source=str(path))
     return scene.with_overrides(overrides) if overrides else scene
 
 
