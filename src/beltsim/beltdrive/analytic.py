@@ -263,8 +263,8 @@ def capacity(P: DriveParams, omega1: float | None = None) -> float:
     lo = P.rho * (omega1 * R1) ** 2
     if not resid(lo) < 0:
         raise LiftOffError(f"drive.installation_tension: {P.N0:g} N leaves the belt without "
-                           f"contact pressure (it lifts off) even unloaded at {omega1:g} rad/s (the "
-                           f"centrifugal tension rho c^2 is about {lo:.4g} N)")
+                           f"contact pressure (it lifts off) even unloaded at {omega1:g} "
+                           f"rad/s (the centrifugal tension rho c^2 is about {lo:.4g} N)")
     hi = _bracket(resid, max(2.0 * P.N0, 2.0 * lo, 1.0))
     T1 = brentq(resid, lo, hi, xtol=1e-13 * hi, rtol=1e-15, maxiter=200)
     c, kappa, dT = parts(T1)
