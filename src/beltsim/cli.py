@@ -68,7 +68,7 @@ def _drive_run(args, scene):
     from .beltdrive.run import DriveStatus, simulate
 
     out = Path(args.out or Path("runs/out") / Path(args.scene).stem)
-    result = simulate(scene)
+    result = simulate(scene, snapshot_interval=args.snapshots)
     save_drive_run(result, out)
     summary = result_summary(result)
     print(format_drive(summary, title=scene.title or args.scene))
@@ -337,6 +337,42 @@ def cmd_paper(args):
     return 0
 
 
+def _stored_drive(run_dir, is_drive) -> bool:
+    """Whether a run directory holds a closed drive's run (its scene.toml has [drive])."""
+    import tomllib
+
+    try:
+        return is_drive(tomllib.loads((run_dir / "scene.toml").read_text(encoding="utf-8")))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return False  # the straight belt's reader says what is wrong
+
+
+def _drive_animate(args, scene=None):
+    from pathlib import Path
+
+    from .beltdrive.io import animate_drive_run, save_drive_run
+    from .beltdrive.run import simulate, transit_time
+    from .io.files import prepare_outdir
+
+    if scene is None:
+        src = Path(args.from_dir)
+        out = prepare_outdir(args.out or src)
+    else:
+        interval = args.interval or scene.numerics.get("snapshot_interval") or \
+            transit_time(scene.params) / 8
+        if not interval > 0:
+            raise UsageError(f"--interval: must be > 0 s, got {interval}")
+        out = prepare_outdir(args.out or Path("runs/out") / f"animate_{Path(args.scene).stem}")
+        result = simulate(scene, snapshot_interval=interval)
+        save_drive_run(result, out)
+        print(f"ran {args.scene}: {result.status.value} at t = {result.history['t'][-1]:.4g} "
+              f"s, {len(result.snapshots['t'])} snapshots")
+        src = out
+    path = animate_drive_run(src, out / f"transient.{args.format}", args.fps)
+    print(f"wrote {path}")
+    return 0
+
+
 def cmd_animate(args):
     from pathlib import Path
 
@@ -350,12 +386,18 @@ def cmd_animate(args):
     if args.from_dir:
         if args.scene or args.overrides:
             raise UsageError("--from DIR animates a stored run: give no SCENE or --set")
+        from .beltdrive.scene import is_drive
+
+        if _stored_drive(Path(args.from_dir), is_drive):
+            return _drive_animate(args)
         src = Path(args.from_dir)
         out = prepare_outdir(args.out or src)
     else:
         if not args.scene:
             raise UsageError("animate: give a SCENE file, or --from DIR")
-        scene = _straight_only(args, _scene(args))
+        scene = _scene(args)
+        if _is_drive(scene):
+            return _drive_animate(args, scene)
         P = scene.params
         interval = args.interval or scene.numerics.get("snapshot_interval") or P.L / (4 * P.c)
         if not interval > 0:
@@ -375,9 +417,14 @@ def cmd_animate(args):
 
 
 def cmd_plot(args):
+    from pathlib import Path
+
+    from .beltdrive.io import plot_drive_run
+    from .beltdrive.scene import is_drive
     from .plots.run import plot_run
 
-    paths = plot_run(args.dir, args.out)
+    paths = (plot_drive_run if _stored_drive(Path(args.dir), is_drive) else plot_run)(
+        args.dir, args.out)
     print("wrote " + ", ".join(str(p) for p in paths))
     return 0
 

@@ -204,6 +204,7 @@ class DriveResult:
     analytic: object | None = None
     wall_time: float = 0.0
     statistics: dict = field(default_factory=dict)
+    snapshots: dict = field(default_factory=dict)
 
     @property
     def converged(self) -> bool:
@@ -276,6 +277,18 @@ def solve_steady(scene: DriveScene, elements: int | None = None) -> DriveResult:
                        statistics={"newton_iterations": its})
 
 
+#: what a snapshot holds: nodal tension, friction and slip, and the two speeds
+SNAPSHOT_KEYS = ("t", "tension", "friction", "slip", "belt_speed", "driven_speed")
+
+
+def _snapshot(snaps: dict, t: float, flds: dict, summary: dict) -> None:
+    snaps["t"].append(t)
+    for k in ("tension", "friction", "slip"):
+        snaps[k].append(flds[k].copy())
+    snaps["belt_speed"].append(summary["belt_speed"])
+    snaps["driven_speed"].append(summary["driven_speed"])
+
+
 def bdf_coefficients(h, h_prev):
     """(a0, a1, a2) of the variable-step BDF2 derivative y'_n = a0 y_n + a1 y_n-1 +
     a2 y_n-2; backward Euler (a2 = 0) when h_prev is None."""
@@ -285,9 +298,22 @@ def bdf_coefficients(h, h_prev):
     return (1.0 + 2.0 * r) / ((1.0 + r) * h), -(1.0 + r) / h, r * r / ((1.0 + r) * h)
 
 
-def simulate(scene: DriveScene, elements: int | None = None, progress=None) -> DriveResult:
+def simulate(scene: DriveScene, elements: int | None = None, progress=None,
+             snapshot_interval: float | None = None) -> DriveResult:
     """Run the drive from rest (c = omega = 0, uniform N0) by BDF2 time steps until the
-    steady state, gross slip, lift-off or t_end."""
+    steady state, gross slip, lift-off or t_end.
+
+    Parameters
+    ----------
+    scene : DriveScene
+    elements : int, optional
+        Stands for numerics.elements.
+    progress : callable, optional
+        Called as progress(t, t_end) after every step.
+    snapshot_interval : float, optional
+        Store the nodal tension, friction and slip every this many seconds (and the last
+        state) in ``result.snapshots``, for animations.
+    """
     num = resolve(scene, elements)
     if num.integrator == "steady":
         return solve_steady(scene, elements)
@@ -308,6 +334,8 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None) -> D
     start = time.perf_counter()
     strain = P.N0 / P.b1
     full_slip_steps = 0
+    snaps = {k: [] for k in SNAPSHOT_KEYS}
+    next_snap = 0.0
     while t < num.t_end - 1e-12 * num.t_end:
         h = min(dt, num.t_end - t)
         a0, a1, a2 = bdf_coefficients(h, h_prev)
@@ -357,6 +385,9 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None) -> D
                 hist[k].append(sm[k])
         if progress is not None:
             progress(t, num.t_end)
+        if snapshot_interval and t >= next_snap:
+            _snapshot(snaps, t, flds, sm)
+            next_snap = t + snapshot_interval
         # gross slip: a whole arc slides while the driven pulley slows down (the load wins)
         arcs_slide = [bool(np.all(flds["slip"][mesh.arc == a])) for a in (0, 1)]
         w2dot = a0 * y[lay.omega2] + h2
@@ -379,13 +410,16 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None) -> D
     rim1 = value(speed, t)
     m2 = value(load, t)
     flds = fields_of(y, lay, mesh, P, prm, rim1)
+    final = summary_of(y, lay, mesh, P, prm, rim1, m2, rim1 / R1)
+    if snapshot_interval and (not snaps["t"] or snaps["t"][-1] < t):
+        _snapshot(snaps, t, flds, final)
     try:
         ana = analytic_of(P)
     except NoSolutionError:
         ana = None
-    return DriveResult(scene, num, status, reason, mesh.x.copy(), flds,
-                       summary_of(y, lay, mesh, P, prm, rim1, m2, rim1 / R1),
+    return DriveResult(scene, num, status, reason, mesh.x.copy(), flds, final,
                        history={k: np.asarray(v) for k, v in hist.items()}, analytic=ana,
+                       snapshots={k: np.asarray(v) for k, v in snaps.items()},
                        wall_time=wall,
                        statistics={"steps": steps, "newton_iterations": its_total,
                                    "rejected_steps": rejected})
