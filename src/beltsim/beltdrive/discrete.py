@@ -149,7 +149,8 @@ def string_guess(sol, mesh: LoopMesh, lay: Layout) -> np.ndarray:
         p = sol.pressure(mesh.x[on])
         lam = np.where(p > 0, -sol.friction(mesh.x[on]) / (P.mu * np.where(p > 0, p, 1.0)),
                        0.0)
-        y[2 * lay.N:2 * lay.N + lay.M] = np.clip(lam, -1.0, 1.0)
+        # inside (-1, 1): the regularised laws' inverse is singular on the boundary
+        y[2 * lay.N:2 * lay.N + lay.M] = np.clip(lam, -1.0 + 1e-9, 1.0 - 1e-9)
     y[lay.c] = sol.c
     y[lay.omega2] = sol.omega2
     return y

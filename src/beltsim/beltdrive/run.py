@@ -11,10 +11,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import NoSolutionError, NumericalError, SceneError
+from ..physics.friction import EXACT, saturation
 from ..problem.drive import Profile, _profile, value
 from .analytic import capacity, solve_string
 from .discrete import (
     DEFAULT_ELEMENTS,
+    creep_speed,
     Layout,
     law_of,
     layout_of,
@@ -75,7 +77,9 @@ def resolve(scene: DriveScene, elements: int | None = None) -> DriveNumerics:
     law = law_of(P, nm.get("friction_law"))
     reg = None
     if law in ("tanh", "sqrt"):
-        reg = nm.get("regularisation", 1e-3 * P.omega1 * P.geometry.R1 * P.N0 / P.b1)
+        # a tenth of the creep speed: sharper ones stall the Newton iteration (the exact law
+        # is the default and has no regularisation error)
+        reg = nm.get("regularisation", 0.1 * creep_speed(P))
     transit = transit_time(P)
     ramp_time = nm.get("ramp_time", 2.0 * transit)
     settle = max(ramp_time, _last_table_time(scene))
@@ -133,7 +137,9 @@ def fields_of(y, lay: Layout, mesh: LoopMesh, P: DriveParams, prm, rim1: float) 
     f = -S * lam
     rim = np.where(mesh.arc == 1, w2 * P.geometry.R2, rim1)
     vrel = np.where(on, c * (1.0 + P.N0 / P.b1 + epsb) - rim, 0.0)
-    slip = on & (np.abs(lam) >= 1.0 - 1e-9) if P.mu is not None else np.zeros(N, bool)
+    # sliding: the ratio at the bound (exact law) or saturated (a regularised law's 0.99)
+    level = 1.0 - 1e-9 if prm.law == EXACT else saturation(prm.law)
+    slip = on & (np.abs(lam) >= level) if P.mu is not None else np.zeros(N, bool)
     return {"u": u.copy(), "theta": th.copy(), "tension": tension, "friction": f,
             "pressure": p, "slip_velocity": vrel, "slip": slip, "ratio": lam}
 
@@ -218,8 +224,13 @@ class DriveResult:
             return {}
         ex = self.analytic.summary()
         out = {}
-        for key in ("tight_tension", "slack_tension", "belt_speed", "driven_speed",
-                    "driver_torque", "slip_power"):
+        keys = ["tight_tension", "slack_tension", "belt_speed", "driven_speed",
+                "driver_torque"]
+        if self.scene.params.mu is not None:
+            # with perfect adhesion every node sticks: the exits' dissipation is not a
+            # nodal slip power (see power_loss)
+            keys.append("slip_power")
+        for key in keys:
             out[key] = (self.summary[key] - ex[key]) / abs(ex[key]) if ex[key] else \
                 abs(self.summary[key])
         loss, loss_ex = 1.0 - self.summary["speed_ratio"], 1.0 - ex["speed_ratio"]
@@ -267,8 +278,20 @@ def solve_steady(scene: DriveScene, elements: int | None = None) -> DriveResult:
     sol = solve_string(P)
     y = string_guess(sol, mesh, lay)
     rim1 = P.omega1 * P.geometry.R1
-    its = newton(S, y, steady_rates(lay.N), rim1, P.M2, num.newton_tol,
-                 num.newton_max_iterations)
+    its = 0
+    if num.regularisation is not None:
+        # a regularised law from the creep scale down to its own v_reg, ten by ten: from
+        # the exact law's start a sharp regularisation's Newton does not converge
+        target = prm.v_scale
+        v = creep_speed(P)
+        while v > 10.0 * target:
+            S.params = prm._replace(v_scale=v)
+            its += newton(S, y, steady_rates(lay.N), rim1, P.M2, num.newton_tol,
+                          num.newton_max_iterations)
+            v /= 10.0
+        S.params = prm
+    its += newton(S, y, steady_rates(lay.N), rim1, P.M2, num.newton_tol,
+                  num.newton_max_iterations)
     wall = time.perf_counter() - start
     flds = fields_of(y, lay, mesh, P, prm, rim1)
     return DriveResult(scene, num, DriveStatus.CONVERGED, None, mesh.x.copy(), flds,

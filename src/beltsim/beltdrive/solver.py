@@ -171,12 +171,12 @@ def newton(sys_: System, y, rates, rim1, load, tol=1e-10, max_iterations=40):
             raise NumericalError("non-finite Newton update", kind=FailureKind.NON_FINITE)
         step = 1.0
         if regular:
-            # keep the friction ratios inside (-1, 1): g^{-1} is singular on the boundary
+            # each friction ratio moves at most 99% of the way to the boundary of (-1, 1),
+            # node by node (g^{-1} is singular there), as the straight belt's Newton does
             lam, dl = lay.lam(y), lay.lam(dy)
-            out = np.abs(lam + dl) >= 1.0
-            if np.any(out):
-                room = (np.sign(dl[out]) - lam[out]) / dl[out]
-                step = min(1.0, 0.99 * float(np.min(room)))
+            up, down = lam + dl >= 1.0, lam + dl <= -1.0
+            dl[up] = 0.99 * (1.0 - lam[up])
+            dl[down] = -0.99 * (1.0 + lam[down])
         trial = y + step * dy
         new = np.linalg.norm(sys_.residual(trial, rates, rim1, load) / sys_.rscale)
         while new > merit and step > 1e-3:
