@@ -16,8 +16,8 @@ from ..problem.drive import Profile, _profile, value
 from .analytic import capacity, solve_string
 from .discrete import (
     DEFAULT_ELEMENTS,
-    creep_speed,
     Layout,
+    creep_speed,
     law_of,
     layout_of,
     loop_mesh,

@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from .. import solvers
-from ..errors import NumericalError
+from ..errors import NumericalError, UsageError
 from ..physics.grid import Grid
 from ..problem.drive import mismatch as mismatch_at
 from ..problem.drive import period_of, profile_times
@@ -388,7 +388,10 @@ def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,
     Returns
     -------
     RunResult
-        With ``reference``, the exact steady solution, where the scene has one.
+        With ``reference``, the exact steady solution, where the scene has one. A closed
+        drive (:class:`~beltsim.beltdrive.scene.DriveScene`) runs by
+        :func:`beltsim.beltdrive.simulate` and returns its
+        :class:`~beltsim.beltdrive.run.DriveResult`.
 
     Raises
     ------
@@ -402,8 +405,15 @@ def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,
     >>> result = beltsim.run(beltsim.paper_scene("slip"), progress=True)  # doctest: +SKIP
     >>> result.converged, result.errors()["total_friction"]              # doctest: +SKIP
     """
+    from ..beltdrive.scene import DriveScene
     from .result import reference_of
 
+    if isinstance(scene, DriveScene):
+        from ..beltdrive.run import simulate
+
+        if trackers:
+            raise UsageError("trackers: not available for a closed drive yet")
+        return simulate(scene, snapshot_interval=snapshot_interval)
     result = Simulation(scene, snapshot_interval=snapshot_interval).run(
         progress=progress, raise_on_failure=raise_on_failure, trackers=trackers)
     result.reference = reference_of(scene)
