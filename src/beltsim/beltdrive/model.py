@@ -101,11 +101,13 @@ def _pressure_scale(j, eps, c, mesh, p):
 
 
 @njit(cache=True)
-def assemble(y, rates, rim1, load, mesh, p, R, rows, cols, vals, want_jac):
+def assemble(y, rates, rim1, load, dist, mesh, p, R, rows, cols, vals, want_jac):
     """Residual R of the loop's equations at the unknowns y and, if want_jac, the
     Jacobian as COO triplets (duplicates add up). Returns the number of triplets.
 
-    rim1: the driver's rim speed omega1 R1 at this time; load: M2 at this time.
+    rim1: the driver's rim speed omega1 R1 at this time; load: M2 at this time; dist: the
+    distributed loads (2N: q_u, q_theta at each node, N/m and N m/m; zeros but in
+    manufactured solutions), entering as hbar_j q.
     Rows: axial (2j) and bending (2j + 1) at each node, the friction ratios' equations
     (2N + lidx), the gauge (2N + M, divided by Lambda: metres) and the driven pulley
     (2N + M + 1).
@@ -232,8 +234,8 @@ def assemble(y, rates, rim1, load, mesh, p, R, rows, cols, vals, want_jac):
                     if driven:
                         rows[n], cols[n], vals[n] = iw, 2 * q, -p.R2 * gu
                         n += 1
-        R[2 * j] = ru
-        R[2 * j + 1] = rt
+        R[2 * j] = ru - hb[j] * dist[2 * j]
+        R[2 * j + 1] = rt - hb[j] * dist[2 * j + 1]
     return n
 
 

@@ -145,10 +145,12 @@ def _order(lay: Layout) -> np.ndarray:
                            [lay.c, lay.omega2]])
 
 
-def residual(y, rates: Rates, rim1, load, mesh: LoopMesh, p: LoopParams) -> np.ndarray:
+def residual(y, rates: Rates, rim1, load, mesh: LoopMesh, p: LoopParams,
+             q=None) -> np.ndarray:
     """The residual of :func:`beltsim.beltdrive.model.assemble` (the kernel's layout).
 
-    rim1: the driver's rim speed omega1 R1; load: the load torque M2.
+    rim1: the driver's rim speed omega1 R1; load: the load torque M2; q: distributed loads
+    (2N: q_u, q_theta at each node), entering as hbar_j q (none by default).
     """
     lay = layout_of(mesh)
     f = fields(y, rates, mesh)
@@ -163,6 +165,9 @@ def residual(y, rates: Rates, rim1, load, mesh: LoopMesh, p: LoopParams) -> np.n
                + p.b2 * hb * f.theta - p.lever * F)
     s = slip_velocity(y, rates, rim1, mesh, p) / p.v_scale
     ratio = ratio_equation(f.lam, s, p.law)[0]
+    if q is not None:
+        axial = axial - hb * q[0::2]
+        bending = bending - hb * q[1::2]
     gauge = np.sum(hb * f.u) / np.sum(hb)
     pulley = p.J2 * f.omega2t + load + p.R2 * np.sum(F[mesh.arc == 1])
     out = np.empty(lay.size)

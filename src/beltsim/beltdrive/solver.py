@@ -63,7 +63,7 @@ class BorderedBand:
         self.n_int = len(interior)
         self.pos = np.empty_like(order)
         self.pos[order] = np.arange(len(order))
-        n = assemble(np.zeros(lay.size), steady_rates(N), 1.0, 0.0, sys_.mesh, sys_.params,
+        n = assemble(np.zeros(lay.size), steady_rates(N), 1.0, 0.0, sys_.q, sys_.mesh, sys_.params,
                      sys_.R, sys_.rows, sys_.cols, sys_.vals, True)
         pi, pj = self.pos[sys_.rows[:n]], self.pos[sys_.cols[:n]]
         inner = (pi < self.n_int) & (pj < self.n_int)
@@ -116,25 +116,26 @@ class System:
         self.rows = np.zeros(n, dtype=np.int64)
         self.cols = np.zeros(n, dtype=np.int64)
         self.vals = np.zeros(n)
+        self.q = np.zeros(2 * self.lay.N)  # distributed loads: manufactured solutions only
 
         self.band = BorderedBand(self)
 
     def update(self, y, rates, rim1, load):
         """(R(y), the Newton update -J^{-1} R)."""
-        n = assemble(y, rates, rim1, load, self.mesh, self.params, self.R, self.rows,
+        n = assemble(y, rates, rim1, load, self.q, self.mesh, self.params, self.R, self.rows,
                      self.cols, self.vals, True)
         R = self.R.copy()
         return R, self.band.solve(self, n, R)
 
     def residual(self, y, rates, rim1, load):
         """R(y) (a copy)."""
-        assemble(y, rates, rim1, load, self.mesh, self.params, self.R, self.rows, self.cols,
+        assemble(y, rates, rim1, load, self.q, self.mesh, self.params, self.R, self.rows, self.cols,
                  self.vals, False)
         return self.R.copy()
 
     def jacobian(self, y, rates, rim1, load):
         """(R(y), J(y)) with J a CSC matrix."""
-        n = assemble(y, rates, rim1, load, self.mesh, self.params, self.R, self.rows,
+        n = assemble(y, rates, rim1, load, self.q, self.mesh, self.params, self.R, self.rows,
                      self.cols, self.vals, True)
         size = self.lay.size
         J = sp.csc_matrix((self.vals[:n], (self.rows[:n], self.cols[:n])), shape=(size, size))
