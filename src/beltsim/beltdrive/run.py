@@ -36,6 +36,10 @@ SUMMARY_KEYS = ("tight_tension", "slack_tension", "belt_speed", "driven_speed", 
 
 #: the smallest step a Newton failure may halve to, relative to numerics.dt
 MIN_STEP_FRACTION = 1e-4
+#: BDF2's local error per step, relative to the unknowns' scales (discrete.scales)
+DEFAULT_TIME_TOL = 1e-4
+#: the first step, relative to numerics.dt (the largest step)
+FIRST_STEP_FRACTION = 1e-3
 #: steps in a row with a whole arc sliding and the driven pulley slowing: gross slip
 GROSS_SLIP_STEPS = 3
 
@@ -62,6 +66,7 @@ class DriveNumerics:
     dt: float
     t_end: float
     steady_tol: float
+    time_tol: float
     newton_tol: float
     newton_max_iterations: int
 
@@ -83,7 +88,8 @@ def resolve(scene: DriveScene, elements: int | None = None) -> DriveNumerics:
     transit = transit_time(P)
     ramp_time = nm.get("ramp_time", 2.0 * transit)
     settle = max(ramp_time, _last_table_time(scene))
-    dt = nm.get("dt", ramp_time / 100.0 if ramp_time > 0 else transit / 50.0)
+    # the largest step; the steps adapt below it to the local error's time_tol
+    dt = nm.get("dt", transit / 4.0)
     t_end = nm.get("t_end", settle + 40.0 * transit)
     if dt > t_end:
         raise SceneError("numerics.dt", f"must be <= numerics.t_end = {t_end!r}, got {dt!r}")
@@ -91,7 +97,8 @@ def resolve(scene: DriveScene, elements: int | None = None) -> DriveNumerics:
         integrator=nm.get("integrator", "implicit"),
         elements=elements or nm.get("elements", DEFAULT_ELEMENTS), friction_law=law,
         regularisation=reg, ramp_time=ramp_time, dt=dt, t_end=t_end,
-        steady_tol=nm.get("steady_tol", 1e-7), newton_tol=nm.get("newton_tol", 1e-10),
+        steady_tol=nm.get("steady_tol", 1e-7),
+        time_tol=nm.get("time_tol", DEFAULT_TIME_TOL), newton_tol=nm.get("newton_tol", 1e-10),
         newton_max_iterations=nm.get("newton_max_iterations", 40))
 
 
@@ -312,6 +319,37 @@ def _snapshot(snaps: dict, t: float, flds: dict, summary: dict) -> None:
     snaps["driven_speed"].append(summary["driven_speed"])
 
 
+def local_error(y, pred, yscale, lay: Layout) -> float:
+    """BDF2's local error from the quadratic predictor's (Milne's device: the error
+    constants -2/9 and 1 give 2/11 of the difference), relative to the unknowns' scales:
+    the root mean square over the fields (a front crossing a node makes a kink at that
+    node only) and the belt's and the driven pulley's speeds."""
+    e = np.abs(y - pred) / yscale * (2.0 / 11.0)
+    nu = 2 * lay.N
+    return float(max(np.sqrt(np.mean(e[:nu] ** 2)), e[lay.c], e[lay.omega2]))
+
+
+def predictor(past, t):
+    """The quadratic through the last three accepted states, at t (None before three)."""
+    if len(past) < 3:
+        return None
+    (t0, y0), (t1, y1), (t2, y2) = past
+    l0 = (t - t1) * (t - t2) / ((t0 - t1) * (t0 - t2))
+    l1 = (t - t0) * (t - t2) / ((t1 - t0) * (t1 - t2))
+    l2 = (t - t0) * (t - t1) / ((t2 - t0) * (t2 - t1))
+    return l0 * y0 + l1 * y1 + l2 * y2
+
+
+def profile_stops(scene: DriveScene) -> list:
+    """The times of the drive's table rows: steps land on them (a load step is a kink)."""
+    out = set()
+    for key in ("driver_speed", "load_torque"):
+        v = scene.drive[key]
+        if isinstance(v, list):
+            out.update(float(row[0]) for row in v)
+    return sorted(out)
+
+
 def bdf_coefficients(h, h_prev):
     """(a0, a1, a2) of the variable-step BDF2 derivative y'_n = a0 y_n + a1 y_n-1 +
     a2 y_n-2; backward Euler (a2 = 0) when h_prev is None."""
@@ -348,8 +386,14 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
     nu = 2 * lay.N
     v_prev = np.zeros(nu)  # rates of (u, theta) at the previous steps
     y_prev, y_prev2, v_prev2 = y.copy(), None, None
+    past = [(0.0, y.copy())]  # the last accepted states, for the predictor
     h_prev = None
-    t, dt = 0.0, num.dt
+    t = 0.0
+    dt = num.dt * FIRST_STEP_FRACTION
+    stops = sorted(tt for tt in profile_stops(scene) if 0.0 < tt < num.t_end) + [num.t_end]
+    yscale = S.yscale
+    err_mask = np.ones(lay.size, bool)
+    err_mask[2 * lay.N:2 * lay.N + lay.M] = False  # the friction ratios: no predictor
     hist = {k: [] for k in ("t", "omega1", "load_torque", *SUMMARY_KEYS, "driver_power",
                             "load_power")}
     status, reason = DriveStatus.REACHED_END, None
@@ -357,10 +401,14 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
     start = time.perf_counter()
     strain = P.N0 / P.b1
     full_slip_steps = 0
+    just_rejected = False
     snaps = {k: [] for k in SNAPSHOT_KEYS}
     next_snap = 0.0
     while t < num.t_end - 1e-12 * num.t_end:
-        h = min(dt, num.t_end - t)
+        stop = next(tt for tt in stops if tt > t * (1 + 1e-12))
+        h = min(dt, stop - t)
+        if stop - t - h < 0.05 * h:  # no sliver of a step before a table's row
+            h = stop - t
         a0, a1, a2 = bdf_coefficients(h, h_prev)
         hu = a1 * y_prev[:nu] + (a2 * y_prev2[:nu] if y_prev2 is not None else 0.0)
         hv = a1 * v_prev + (a2 * v_prev2 if v_prev2 is not None else 0.0)
@@ -372,7 +420,10 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
         t_new = t + h
         rim1 = value(speed, t_new)
         m2 = value(load, t_new)
+        pred = predictor(past, t_new)
         y_try = y.copy()
+        if pred is not None:
+            y_try[err_mask] = pred[err_mask]
         try:
             its = newton(S, y_try, rates, rim1, m2, num.newton_tol, num.newton_max_iterations)
         except NumericalError as exc:
@@ -383,8 +434,24 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
                 continue
             status, reason = DriveStatus.FAILED, f"t = {t_new:.6g} s: {exc}"
             break
+        if pred is not None:
+            # BDF2's local error from the quadratic predictor's (Milne's device: the two
+            # error constants -2/9 and 1 give 2/11 of their difference)
+            err = local_error(y_try, pred, yscale, lay)
+            factor = 0.9 * (num.time_tol / max(err, 1e-300)) ** (1.0 / 3.0)
+            if err > num.time_tol and h > num.dt * MIN_STEP_FRACTION:
+                dt = h * max(0.2, factor)
+                rejected += 1
+                just_rejected = True
+                continue
+            # no growth right after a rejection: the controller would oscillate
+            grow = 1.0 if just_rejected else 2.0
+            dt = min(num.dt, h * min(grow, max(0.5, factor)))
+            just_rejected = False
+        else:
+            dt = min(num.dt, 2.0 * h)
         y[:] = y_try
-        dt = min(num.dt, 2.0 * h) if its <= 4 else h
+        past = (past + [(t_new, y.copy())])[-3:]
         its_total += its
         steps += 1
         v = a0 * y[:nu] + hu
