@@ -124,12 +124,16 @@ class Fields(dict):
     """Nodal arrays of a drive's state (a dict of name -> array)."""
 
 
-def fields_of(y, lay: Layout, mesh: LoopMesh, P: DriveParams, prm, rim1: float) -> dict:
-    """Nodal fields of the unknowns y: u, theta, N (axial force), f (friction, N/m),
-    p (pressure, N/m), v_rel (m/s), slip (bool), and the friction ratio lam."""
+def fields_of(y, lay: Layout, mesh: LoopMesh, P: DriveParams, prm, rim1: float,
+              rates=None) -> dict:
+    """Nodal fields of the unknowns y: u, theta, their rates u_t, theta_t (``rates``: the
+    time step's (u_t, theta_t), None at a steady state), the axial force N, friction f
+    (N/m), pressure p (N/m), slip velocity v_rel (m/s), slip (bool), the friction ratio
+    lam, and the bottom fibre's strain eps_b of the slip velocity's stencil."""
     u, th = lay.u(y), lay.theta(y)
     c, w2 = y[lay.c], y[lay.omega2]
     N = len(mesh.x)
+    ud, td = (np.zeros(N), np.zeros(N)) if rates is None else rates
     # axial force: the upwind three-point strain (as the friction's) at every node
     idx = (np.arange(N)[:, None] + np.arange(-2, 1)[None, :]) % N
     eps = np.sum(mesh.sw * u[idx], axis=1)
@@ -143,12 +147,61 @@ def fields_of(y, lay: Layout, mesh: LoopMesh, P: DriveParams, prm, rim1: float) 
     S = p * P.mu if P.mu is not None else np.where(on, prm.p_ref, 0.0)
     f = -S * lam
     rim = np.where(mesh.arc == 1, w2 * P.geometry.R2, rim1)
-    vrel = np.where(on, c * (1.0 + P.N0 / P.b1 + epsb) - rim, 0.0)
+    vrel = np.where(on, c * (1.0 + P.N0 / P.b1 + epsb) + ud + prm.lever * td - rim, 0.0)
     # sliding: the ratio at the bound (exact law) or saturated (a regularised law's 0.99)
     level = 1.0 - 1e-9 if prm.law == EXACT else saturation(prm.law)
     slip = on & (np.abs(lam) >= level) if P.mu is not None else np.zeros(N, bool)
-    return {"u": u.copy(), "theta": th.copy(), "tension": tension, "friction": f,
-            "pressure": p, "slip_velocity": vrel, "slip": slip, "ratio": lam}
+    return {"u": u.copy(), "theta": th.copy(), "u_t": ud.copy(), "theta_t": td.copy(),
+            "tension": tension, "friction": f, "pressure": p, "slip_velocity": vrel,
+            "slip": slip, "ratio": lam, "bottom_strain": np.where(on, epsb, 0.0)}
+
+
+#: the terms of the drive's power balance (W) and its stored energy (J), see power_terms
+POWER_KEYS = ("driver_power", "load_power", "slip_power", "damping_power",
+              "gyroscopic_power", "transport_power", "energy")
+
+
+def power_terms(y, flds: dict, cdot: float, lay: Layout, mesh: LoopMesh, P: DriveParams,
+                rim1: float, load: float) -> dict:
+    """The semi-discrete power balance of the loop (W) and its stored energy E (J)::
+
+        dE/dt = driver - load - slip - damping - gyroscopic + transport
+
+    It follows from the rows of the axial equation times (c + u_t), the bending rows times
+    theta_t and the driven pulley's times omega2, summed over the loop (the gauge makes
+    every sum of hbar u_t vanish): E = rho Lambda c^2 / 2 + the belt's kinetic energy of
+    u_t, theta_t + B(c), A(c), b2 strain energies + J2 omega2^2 / 2; slip = -sum F v_rel;
+    damping = d sum hbar (rho u_t^2 + I theta_t^2); gyroscopic = 2 c sum (rho u_t,j
+    (u_t,j - u_t,j-1) + I ...), the upwind term's numerical dissipation (>= 0); transport =
+    -c sum F (N0 / b1 + eps_b) - c c_t (rho sum (du)^2 / h + I sum (dtheta)^2 / h), the
+    linearised model's exchange through the transported strain and the speed-dependent
+    stiffnesses (zero at a steady state, to the grid's error).
+    """
+    c, w2 = y[lay.c], y[lay.omega2]
+    F = flds["friction"] * mesh.wf
+    ud, td = flds["u_t"], flds["theta_t"]
+    du, dth = np.diff(np.append(flds["u"], flds["u"][0])), np.diff(
+        np.append(flds["theta"], flds["theta"][0]))
+    he, hb = mesh.he, mesh.hb
+    M1 = P.geometry.R1 * float(np.sum(F[mesh.arc == 0]))
+    strain_u, strain_t = float(np.sum(du * du / he)), float(np.sum(dth * dth / he))
+    B, A = P.b1 - P.rho * c * c, P.a - P.I * c * c
+    gyro = 2.0 * c * float(np.sum(P.rho * ud * (ud - np.roll(ud, 1))
+                                  + P.I * td * (td - np.roll(td, 1))))
+    energy = (0.5 * P.rho * P.geometry.loop_length * c * c
+              + 0.5 * float(np.sum(hb * (P.rho * ud * ud + P.I * td * td)))
+              + 0.5 * (B * strain_u + A * strain_t
+                       + P.b2 * float(np.sum(hb * flds["theta"] ** 2)))
+              + 0.5 * P.J2 * w2 * w2)
+    return {
+        "driver_power": M1 * rim1 / P.geometry.R1, "load_power": load * w2,
+        "slip_power": float(-np.sum(F * flds["slip_velocity"])),
+        "damping_power": P.damping * float(np.sum(hb * (P.rho * ud * ud + P.I * td * td))),
+        "gyroscopic_power": gyro,
+        "transport_power": float(-c * np.sum(F * (P.N0 / P.b1 + flds["bottom_strain"])))
+        - c * cdot * (P.rho * strain_u + P.I * strain_t),
+        "energy": energy,
+    }
 
 
 def _segment_nodes(mesh: LoopMesh, P: DriveParams):
@@ -185,9 +238,8 @@ def slip_arcs(flds: dict, mesh: LoopMesh, P: DriveParams) -> tuple[float, float]
     return out[0], out[1]
 
 
-def summary_of(y, lay, mesh, P, prm, rim1, load, omega1) -> dict:
-    """The summary figures of a state (see SUMMARY_KEYS)."""
-    flds = fields_of(y, lay, mesh, P, prm, rim1)
+def summary_of(y, flds, lay, mesh, P, load, omega1, rim1) -> dict:
+    """The summary figures of a state and its fields (see SUMMARY_KEYS)."""
     c, w2 = y[lay.c], y[lay.omega2]
     T1, T2 = span_tensions(flds["u"], mesh, P)
     F = flds["friction"] * mesh.wf
@@ -302,7 +354,7 @@ def solve_steady(scene: DriveScene, elements: int | None = None) -> DriveResult:
     wall = time.perf_counter() - start
     flds = fields_of(y, lay, mesh, P, prm, rim1)
     return DriveResult(scene, num, DriveStatus.CONVERGED, None, mesh.x.copy(), flds,
-                       summary_of(y, lay, mesh, P, prm, rim1, P.M2, P.omega1),
+                       summary_of(y, flds, lay, mesh, P, P.M2, P.omega1, rim1),
                        analytic=analytic_of(P), wall_time=wall,
                        statistics={"newton_iterations": its})
 
@@ -394,8 +446,7 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
     yscale = S.yscale
     err_mask = np.ones(lay.size, bool)
     err_mask[2 * lay.N:2 * lay.N + lay.M] = False  # the friction ratios: no predictor
-    hist = {k: [] for k in ("t", "omega1", "load_torque", *SUMMARY_KEYS, "driver_power",
-                            "load_power")}
+    hist = {k: [] for k in ("t", "omega1", "load_torque", *SUMMARY_KEYS, *POWER_KEYS)}
     status, reason = DriveStatus.REACHED_END, None
     steps = its_total = rejected = 0
     start = time.perf_counter()
@@ -458,7 +509,7 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
         y_prev2, v_prev2 = y_prev, v_prev
         y_prev, v_prev = y.copy(), v
         h_prev, t = h, t_new
-        flds = fields_of(y, lay, mesh, P, prm, rim1)
+        flds = fields_of(y, lay, mesh, P, prm, rim1, (v[0::2], v[1::2]))
         on = mesh.lidx >= 0
         if np.any(flds["pressure"][on] <= 0.0):
             j = np.flatnonzero(on & (flds["pressure"] <= 0.0))[0]
@@ -466,7 +517,9 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
                 f"t = {t:.6g} s: the contact pressure fell to zero at x = {mesh.x[j]:.4g} m "
                 f"(the belt lifts off; this model does not describe lift-off)")
             break
-        sm = summary_of(y, lay, mesh, P, prm, rim1, m2, rim1 / R1)
+        cdot = a0 * y[lay.c] + hc
+        sm = summary_of(y, flds, lay, mesh, P, m2, rim1 / R1, rim1)
+        sm.update(power_terms(y, flds, cdot, lay, mesh, P, rim1, m2))
         hist["t"].append(t)
         hist["omega1"].append(rim1 / R1)
         hist["load_torque"].append(m2)
@@ -490,7 +543,6 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
             break
         if t < settle:
             continue
-        cdot = a0 * y[lay.c] + hc
         rate = max(abs(cdot) / rim1, abs(w2dot) * P.geometry.R2 / rim1,
                    float(np.max(np.abs(v[0::2]))) / (rim1 * strain))
         if rate * transit_time(P) < num.steady_tol:
@@ -499,8 +551,9 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
     wall = time.perf_counter() - start
     rim1 = value(speed, t)
     m2 = value(load, t)
-    flds = fields_of(y, lay, mesh, P, prm, rim1)
-    final = summary_of(y, lay, mesh, P, prm, rim1, m2, rim1 / R1)
+    flds = fields_of(y, lay, mesh, P, prm, rim1,
+                     None if not steps else (v_prev[0::2], v_prev[1::2]))
+    final = summary_of(y, flds, lay, mesh, P, m2, rim1 / R1, rim1)
     if snapshot_interval and (not snaps["t"] or snaps["t"][-1] < t):
         _snapshot(snaps, t, flds, final)
     try:
