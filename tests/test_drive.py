@@ -261,8 +261,15 @@ def test_cli_runs_and_refuses_drives(tmp_path):
               tmp_path / "b")
     assert res.returncode == 2 and res.stderr.count("\n") == 1
     assert "drive.centre_distance" in res.stderr
-    res = cli("sweep", "drive_flat", "--vary", "drive.load_torque=1,2")
+    res = cli("convergence", "drive_flat")
     assert res.returncode == 2 and "closed drive" in res.stderr
+    # a torque sweep past the capacity (98.4 N m): gross slip is an outcome, exit 0
+    res = cli("sweep", "drive_flat", "--set", "physics.model=string", "--vary",
+              "drive.load_torque=40,110", "--workers", "1", "--out", tmp_path / "s")
+    assert res.returncode == 0, res.stderr
+    assert "gross slip" in res.stdout and (tmp_path / "s" / "characteristic.png").is_file()
+    res = cli("sweep", "drive_flat", "--vary", "drive.pulleys=1,2", "--out", tmp_path / "t")
+    assert res.returncode == 2 and "drive.pulleys" in res.stderr
 
 
 @pytest.mark.verification

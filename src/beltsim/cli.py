@@ -289,10 +289,12 @@ def cmd_sweep(args):
     from .plots.studies import CREEP_COLLAPSE_DPI, creep_collapse
     from .studies import sweep
 
-    scene = _straight_only(args, _scene(args))
-    key, values = sweep.parse_vary(args.vary)
+    scene = _scene(args)
+    key, values = sweep.parse_vary(args.vary, scene)
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers: must be >= 1, got {args.workers}")
+    if _is_drive(scene):
+        return _drive_sweep(args, scene, key, values)
     out = prepare_outdir(args.out or Path("runs/out") / f"sweep_{Path(args.scene).stem}")
     collapse = key == "contact.max_friction"
     executor = sweep.make_executor(args.workers, args.scheduler)
@@ -314,6 +316,45 @@ def cmd_sweep(args):
                     dpi=CREEP_COLLAPSE_DPI)
         print(f"wrote {out / 'creep_collapse.png'}")
     return 0 if all(r["converged"] for r in rows) else 1
+
+
+def _drive_sweep(args, scene, key, values):
+    from pathlib import Path
+
+    import numpy as np
+
+    from .beltdrive import plots
+    from .beltdrive.run import SUMMARY_KEYS
+    from .io.files import prepare_outdir, write_csv
+    from .plots.common import save_figure
+    from .studies import sweep
+
+    out = prepare_outdir(args.out or Path("runs/out") / f"sweep_{Path(args.scene).stem}")
+
+    def show(row):
+        print(f"  {key} = {row['value']!r:<10} {row['status']:<14} speed ratio "
+              f"{row['speed_ratio']:.6f}, tight {row['tight_tension']:.5g} N, slack "
+              f"{row['slack_tension']:.5g} N, wall {row['wall_time']:.3g} s", flush=True)
+    rows = sweep.sweep(scene, key, values, sweep.make_executor(args.workers, args.scheduler),
+                       progress=show)
+    cols = [key, "status", *SUMMARY_KEYS, *(f"{k}_analytic" for k in SUMMARY_KEYS),
+            "wall_time"]
+    data = [[r["value"] for r in rows], [r["status"] for r in rows]] + [
+        [np.nan if r[c] is None else r[c] for r in rows] for c in cols[2:]]
+    write_csv(out / "sweep.csv", cols, data, text_columns=("status",))
+    print(f"wrote {out / 'sweep.csv'}")
+    if key == "drive.load_torque":
+        ok = [r for r in rows if r["converged"]]
+        fig = save_figure(
+            plots.plot_characteristic, out / "characteristic.png",
+            [r["value"] for r in ok], [1.0 - r["speed_ratio"] for r in ok],
+            [r["efficiency"] for r in ok], capacity=rows[0]["capacity"],
+            analytic={"speed_loss": [1.0 - r["speed_ratio_analytic"] for r in ok],
+                      "efficiency": [r["efficiency_analytic"] for r in ok]})
+        print(f"wrote {fig}")
+    # gross slip is a physical outcome of a sweep past the capacity, not a failure
+    bad = [r for r in rows if r["status"] not in ("converged", "gross slip")]
+    return 1 if bad else 0
 
 
 def cmd_paper(args):

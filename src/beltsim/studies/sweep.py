@@ -19,16 +19,39 @@ KEYS = ("total_friction", "stick_friction", "slip_friction", "slip_start")
 EXACT_SAMPLES = 801  # points of the exact fields kept for a figure
 
 
-def parse_vary(text: str):
-    """``SECTION.KEY=V1,V2,...`` -> (key, [values]); each value validated with the scene."""
+def parse_vary(text: str, scene=None):
+    """``SECTION.KEY=V1,V2,...`` -> (key, [values]); each value validated with the scene
+    (a closed drive's keys with the drive's schema)."""
+    from ..beltdrive.scene import DriveScene
+
     if "=" not in text:
         raise UsageError(f"--vary {text}: expected SECTION.KEY=V1,V2,...")
     key, raw = text.split("=", 1)
     values = [parse_assignment(f"{key}={v.strip()}")[1] for v in raw.split(",") if v.strip()]
     if not values:
         raise UsageError(f"--vary {text}: no values")
-    set_key({}, key.strip(), values[0])  # the key must be one the schema knows
+    if isinstance(scene, DriveScene):
+        scene.with_overrides([(key.strip(), values[0])])
+    else:
+        set_key({}, key.strip(), values[0])  # the key must be one the schema knows
     return key.strip(), values
+
+
+def run_drive_point(scene_dict: dict, key: str, value) -> dict:
+    """One sweep point of a closed drive: its run from rest and its analytic steady state
+    (none beyond the capacity: gross slip is then the run's expected outcome)."""
+    from ..beltdrive.analytic import capacity
+    from ..beltdrive.run import SUMMARY_KEYS, simulate
+    from ..beltdrive.scene import DriveScene
+
+    scene = DriveScene(scene_dict).with_overrides([(key, value)])
+    res = simulate(scene)
+    row = {"value": value, **{k: res.summary[k] for k in SUMMARY_KEYS}}
+    exact = res.analytic.summary() if res.analytic is not None else {}
+    row.update({f"{k}_analytic": exact.get(k) for k in SUMMARY_KEYS})
+    row.update(status=res.status.value, converged=res.converged, wall_time=res.wall_time,
+               reason=res.reason, capacity=capacity(scene.params))
+    return row
 
 
 def run_point(scene_dict: dict, key: str, value, keep_theta=False) -> dict:
@@ -77,17 +100,23 @@ def make_executor(workers: int | None = None, scheduler: str | None = None) -> E
     return ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1)
 
 
-def sweep(scene: Scene, key: str, values, executor: Executor | None = None,
+def sweep(scene, key: str, values, executor: Executor | None = None,
           keep_theta: bool = False, progress=None) -> list[dict]:
     """Run every value on the executor; rows in the order of ``values``."""
     # validate every point up front: a bad value fails before any run starts
     for v in values:
         scene.with_overrides([(key, v)])
+    from ..beltdrive.scene import DriveScene
+
     own = executor is None
     executor = executor or make_executor()
     try:
-        futures = [executor.submit(run_point, scene.to_dict(), key, v, keep_theta)
-                   for v in values]
+        if isinstance(scene, DriveScene):
+            futures = [executor.submit(run_drive_point, scene.to_dict(), key, v)
+                       for v in values]
+        else:
+            futures = [executor.submit(run_point, scene.to_dict(), key, v, keep_theta)
+                       for v in values]
         rows = []
         for f in futures:
             rows.append(f.result())
