@@ -299,3 +299,11 @@ def test_power_balance_of_a_start_up():
         assert H["energy"][-1] == pytest.approx(kinetic, rel=2e-3)
     assert mismatch[1e-4] < 3e-4
     assert mismatch[1e-4] < 0.5 * mismatch[1e-3]
+
+
+@pytest.mark.unit
+def test_a_straight_scene_reader_points_a_drive_to_load_scene():
+    import beltsim
+    with pytest.raises(SceneError, match=r"\[drive\].*load_scene"):
+        beltsim.Scene.load(scene_path("drive_flat"))
+    assert isinstance(beltsim.load_scene(scene_path("drive_flat")), DriveScene)
