@@ -59,7 +59,8 @@ plt.show()
 # %%
 # The start-up: the belt and the driven pulley follow the driver's ramp, and the span
 # tensions split as the load comes on. The driver's torque settles at R1 / R2 of the
-# load; dashed, the analytic steady values.
+# load; dashed, the analytic steady values. (In the first steps both speeds are tiny and
+# their ratio says little.)
 
 plots.plot_drive_history(result.history["t"], result.history,
                          steady=result.analytic.summary())

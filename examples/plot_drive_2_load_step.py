@@ -3,8 +3,8 @@ A closed drive: a load step
 ===========================
 
 The shipped ``drive_load_step`` scene is ``drive_flat`` with the load as a table: it
-rises to 30 N m over the start-up, holds until the drive has settled, and doubles to
-60 N m within 10 ms at t = 1 s. The slip arcs grow, the tight side takes the extra
+comes on once the belt is moving, rises to 30 N m by the end of the start-up, holds until
+the drive has settled, and doubles to 60 N m within 10 ms at t = 1 s. The slip arcs grow, the tight side takes the extra
 tension from the slack side, the driven pulley falls back a little further behind the
 driver, and the drive settles on the steady state of the new load. From the command
 line (``--snapshots`` keeps the frames for ``beltsim animate --from``)::
@@ -61,7 +61,9 @@ plt.show()
 # %%
 # The speed ratio around the step, enlarged: the speed loss 1 - omega2 R2 / (omega1 R1)
 # doubles with the load (it grows with the tension difference), and the slip arcs on
-# both pulleys grow to carry it.
+# both pulleys grow to carry it. The analytic states are the string's; the beam's slip
+# arc on the small driver is a little shorter, by the boundary layer of its friction at
+# the slip front.
 
 fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True, layout="constrained")
 on = h["t"] > 0.8
