@@ -4,10 +4,10 @@ A closed drive: a load step
 
 The shipped ``drive_load_step`` scene is ``drive_flat`` with the load as a table: it
 comes on once the belt is moving, rises to 30 N m by the end of the start-up, holds until
-the drive has settled, and doubles to 60 N m within 10 ms at t = 1 s. The slip arcs grow, the tight side takes the extra
-tension from the slack side, the driven pulley falls back a little further behind the
-driver, and the drive settles on the steady state of the new load. From the command
-line (``--snapshots`` keeps the frames for ``beltsim animate --from``)::
+the drive has settled, and doubles to 60 N m within 10 ms at t = 1 s. The slip arcs grow,
+the tight side takes the extra tension from the slack side, the driven pulley falls back
+a little further behind the driver, and the drive settles on the steady state of the new
+load. From the command line (``--snapshots`` keeps the frames for ``beltsim animate --from``)::
 
     beltsim run drive_load_step --snapshots 0.02
     beltsim plot runs/out/drive_load_step
