@@ -7,11 +7,17 @@
     constant of :mod:`beltsim.solvers.settings`). The build fails when the content names a key
     the schema does not have, or leaves out one it has.
 
+``drive-keys SECTION``
+    The same for a closed drive's scene, from :data:`beltsim.beltdrive.scene.SCHEMA`; a
+    default may quote the constants of :mod:`beltsim.beltdrive.scene`,
+    :mod:`beltsim.beltdrive.discrete` and :mod:`beltsim.beltdrive.run`.
+
 ``beltsim-cli COMMAND``
     Usage, description and options of one subcommand of ``beltsim``, from
     :func:`beltsim.cli.build_parser`.
 
-At the end of a build every schema section and every subcommand must have been shown.
+At the end of a build every section of both schemas and every subcommand must have been
+shown.
 The module pages of the API reference leave out what the package exports at its top
 level, which has a page of its own.
 """
@@ -27,6 +33,9 @@ from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 
 import beltsim
+from beltsim.beltdrive import discrete as drive_discrete
+from beltsim.beltdrive import run as drive_run
+from beltsim.beltdrive import scene as drive_scene
 from beltsim.cli import build_parser
 from beltsim.problem import scene as scene_module
 from beltsim.solvers import settings
@@ -39,13 +48,16 @@ def _cell(text: str) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
 
-def rule_text(rule, key="") -> str:
-    """A rule of the schema in words (``key``: the section.key it belongs to)."""
-    if key == "numerics.integrator":  # the registry checks it: its names
+def rule_text(rule, key="", registry=True) -> str:
+    """A rule of the schema in words (``key``: the section.key it belongs to; ``registry``:
+    the straight belt's schema, whose integrator the scheme registry checks)."""
+    if registry and key == "numerics.integrator":  # the registry checks it: its names
         from beltsim import solvers
         return ", ".join(f'`"{n}"`' for n in solvers.names())
     if rule.kind == "profile":
         return "number > 0, table or sine ([drive profiles](drive-profiles.md))"
+    if rule.kind == "load":
+        return "number >= 0, or a table of `[time, value]` rows with values >= 0"
     if rule.kind == "bool":
         return "true or false"
     if rule.kind == "str":
@@ -66,22 +78,23 @@ def rule_text(rule, key="") -> str:
     return " ".join([word, *parts])
 
 
-def _constants() -> dict:
-    """Names a default may quote as ``{NAME}``: the settings module's constants."""
-    return {k: v for k, v in vars(settings).items() if k.isupper()
-            and isinstance(v, (int, float))}
+def _constants(*modules) -> dict:
+    """Names a default may quote as ``{NAME}``: the modules' numeric constants."""
+    return {k: v for m in modules for k, v in vars(m).items() if k.isupper()
+            and isinstance(v, (int, float)) and not isinstance(v, bool)}
 
 
 CONSTANT = re.compile(r"\{([A-Z][A-Z0-9_]*)(?::([^}]*))?\}")
 
 
 def _substitute(text, consts, directive, key):
-    """Replace ``{NAME}`` or ``{NAME:format}`` by a constant of the settings module."""
+    """Replace ``{NAME}`` or ``{NAME:format}`` by a constant of the directive's modules."""
     def value(match):
         name, fmt = match.group(1), match.group(2) or ""
         if name not in consts:
-            raise directive.error(f"scene-keys {key}: the default names {name}, which is not "
-                                  "a constant of beltsim.solvers.settings")
+            where = ", ".join(m.__name__ for m in directive.constant_modules)
+            raise directive.error(f"{directive.name} {key}: the default names {name}, which "
+                                  f"is not a constant of {where}")
         text = format(consts[name], fmt)
         return re.sub(r"e([+-])0*(\d)", lambda m: "e" + m.group(1).strip("+") + m.group(2),
                       text)  # 6e-06 as 6e-6, 2e+10 as 2e10
@@ -93,12 +106,16 @@ class SceneKeys(SphinxDirective):
 
     required_arguments = 1
     has_content = True
+    schema_module = scene_module
+    constant_modules = (settings,)
+    kind = "sections"  # what _shown records
+    registry = True  # the integrator is a name of the scheme registry
 
     def run(self):
         section = self.arguments[0]
-        schema = scene_module.SCHEMA
+        schema = self.schema_module.SCHEMA
         if section not in schema:
-            raise self.error(f"scene-keys: no section [{section}] in SCHEMA "
+            raise self.error(f"{self.name}: no section [{section}] in SCHEMA "
                              f"(sections: {', '.join(schema)})")
         rules = schema[section]
         given = {}
@@ -107,34 +124,44 @@ class SceneKeys(SphinxDirective):
                 continue
             parts = [p.strip() for p in line.split(" | ", 2)]
             if len(parts) != 3:
-                raise self.error(f"scene-keys {section}: expected 'key | default | meaning', "
-                                 f"got {line!r}")
+                raise self.error(f"{self.name} {section}: expected 'key | default | "
+                                 f"meaning', got {line!r}")
             key = parts[0]
             if key not in rules:
-                raise self.error(f"scene-keys {section}: {key} is not a key of [{section}] "
+                raise self.error(f"{self.name} {section}: {key} is not a key of [{section}] "
                                  f"(SCHEMA has {', '.join(rules)})")
             if key in given:
-                raise self.error(f"scene-keys {section}: {key} twice")
+                raise self.error(f"{self.name} {section}: {key} twice")
             given[key] = parts[1:]
         missing = [k for k in rules if k not in given]
         if missing:
-            raise self.error(f"scene-keys {section}: undocumented keys {', '.join(missing)}")
-        consts = _constants()
+            raise self.error(f"{self.name} {section}: undocumented keys "
+                             f"{', '.join(missing)}")
+        consts = _constants(*self.constant_modules)
         lines = ["| key | rule | default | meaning |", "|---|---|---|---|"]
         for key in rules:  # the schema's order
             default, meaning = given[key]
             default = _substitute(default, consts, self, f"{section}.{key}")
             meaning = _substitute(meaning, consts, self, f"{section}.{key}")
-            rule = _cell(rule_text(rules[key], f"{section}.{key}"))
+            rule = _cell(rule_text(rules[key], f"{section}.{key}", self.registry))
             lines.append(f"| `{key}` | {rule} | {default} | "
                          f"{meaning} |")
-        self.env.note_dependency(scene_module.__file__)
-        self.env.note_dependency(settings.__file__)
-        _shown(self.env, "sections").add(section)
+        for module in (self.schema_module, *self.constant_modules):
+            self.env.note_dependency(module.__file__)
+        _shown(self.env, self.kind).add(section)
         node = nodes.container(classes=["scene-keys"])
         self.state.nested_parse(StringList(lines, self.get_source_info()[0]),
                                 self.content_offset, node)
         return [node]
+
+
+class DriveKeys(SceneKeys):
+    """The table of one closed-drive scene section's keys."""
+
+    schema_module = drive_scene
+    constant_modules = (drive_scene, drive_discrete, drive_run)
+    kind = "drive sections"
+    registry = False  # the drive's integrators are the schema's own choices
 
 
 def _subparsers(parser) -> dict:
@@ -198,20 +225,28 @@ class BeltsimCli(SphinxDirective):
 
 def _shown(env, kind) -> set:
     if not hasattr(env, "beltsim_shown"):
-        env.beltsim_shown = {"sections": set(), "commands": set()}
-    return env.beltsim_shown[kind]
+        env.beltsim_shown = {k: set() for k in SHOWN}
+    return env.beltsim_shown.setdefault(kind, set())
+
+
+#: what the build records as shown: schema sections of both kinds, subcommands
+SHOWN = ("sections", "drive sections", "commands")
 
 
 def _merge(app, env, docnames, other):
     if hasattr(other, "beltsim_shown"):
-        for kind in ("sections", "commands"):
-            _shown(env, kind).update(other.beltsim_shown[kind])
+        for kind in SHOWN:
+            _shown(env, kind).update(other.beltsim_shown.get(kind, ()))
 
 
 def _check(app, env):
     sections = set(scene_module.SCHEMA) - _shown(env, "sections")
     if sections:
         LOG.warning("scene sections without a scene-keys table: %s", ", ".join(sorted(sections)))
+    sections = set(drive_scene.SCHEMA) - _shown(env, "drive sections")
+    if sections:
+        LOG.warning("drive scene sections without a drive-keys table: %s",
+                    ", ".join(sorted(sections)))
     commands = set(_subparsers(build_parser())) - _shown(env, "commands")
     if commands:
         LOG.warning("beltsim commands without a beltsim-cli entry: %s",
@@ -260,6 +295,7 @@ def setup(app):
     # before numpydoc compiles its exclusion pattern (at the default priority, 500)
     app.connect("config-inited", _exclude_fields, priority=400)
     app.add_directive("scene-keys", SceneKeys)
+    app.add_directive("drive-keys", DriveKeys)
     app.add_directive("beltsim-cli", BeltsimCli)
     app.connect("env-merge-info", _merge)
     app.connect("env-check-consistency", _check)

@@ -41,14 +41,15 @@ INDEX_INTRO = (
 
 def _pages():
     """(name, title, build) of every page, in reading order."""
-    from . import balance, convergence, end_states, paper, paths, stability
+    from . import balance, convergence, drive, end_states, paper, paths, stability
 
     return (("paper", paper.TITLE, paper.build),
             ("end_states", end_states.TITLE, end_states.build),
             ("convergence", convergence.TITLE, convergence.build),
             ("paths", paths.TITLE, paths.build),
             ("stability", stability.TITLE, stability.build),
-            ("balance", balance.TITLE, balance.build))
+            ("balance", balance.TITLE, balance.build),
+            ("drive", drive.TITLE, drive.build))
 
 
 def run_page(name: str, title: str, build, quick: bool, out: Path, command: str, sha: str,

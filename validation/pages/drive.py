@@ -1,0 +1,307 @@
+"""Page: the closed belt drive against the string's creep theory: steady convergence, the
+default grid, a start-up from rest, the gross-slip threshold and the power balance."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from beltsim.beltdrive import (
+    DriveScene,
+    DriveStatus,
+    GrossSlipError,
+    capacity,
+    simulate,
+    solve_steady,
+    solve_string,
+)
+from beltsim.beltdrive.discrete import DEFAULT_ELEMENTS, loop_mesh
+from beltsim.problem.scene import shipped_scene
+
+from .kit import Page, fmt, num
+
+TITLE = "The closed belt drive"
+SCENE = "drive_flat"
+STRING = ("physics.model", "string")
+LADDERS = {False: (100, 200, 400, 800, 1600, 3200), True: (100, 200, 400)}
+#: the errors of the ladder, with their column titles; the orders of the first five are
+#: held to the issue's target
+ERRORS = {"tight_tension": "tight tension", "slack_tension": "slack tension",
+          "speed_loss": "speed loss", "slip_arc_driver": "slip arc, driver",
+          "slip_arc_driven": "slip arc, driven", "slip_power": "slip power",
+          "belt_speed": "belt speed", "driver_torque": "driver torque"}
+#: errors that are round-off on every grid (no order to observe)
+EXACT_KEYS = ("driver_torque",)
+ORDER_KEYS = ("tight_tension", "slack_tension", "speed_loss", "slip_arc_driver",
+              "slip_arc_driven")
+#: the issue's targets: the fitted order of those errors, the default grid's errors
+MIN_ORDER = 1.8
+TENSION_TOL = 1e-4
+SPEED_LOSS_TOL = 1e-3
+#: wall-time targets (s) of a default start-up and a steady solve, reported, not failed
+#: (timings depend on the machine's load)
+STARTUP_WALL = 2.0
+STEADY_WALL = 0.02
+#: repetitions of the steady solve for its wall time (the best counts)
+STEADY_REPEATS = 5
+#: loads of the gross-slip runs, as fractions of the string's capacity
+THRESHOLDS = {False: (0.95, 0.99, 1.01, 1.05), True: (0.95, 1.05)}
+QUICK_ELEMENTS = 200
+
+
+def _cmd(*sets: str) -> str:
+    return "`beltsim run " + SCENE + "".join(f" --set {s}" for s in sets) + "`"
+
+
+def _string(overrides=()) -> DriveScene:
+    return shipped_scene(SCENE, [STRING, *overrides])
+
+
+def _h(scene: DriveScene, elements: int) -> float:
+    """The grid's largest element (m)."""
+    return float(loop_mesh(scene.params.geometry, elements).he.max())
+
+
+def _balance(summary: dict) -> tuple[float, float]:
+    """driver power - load power - slip power (W), and that relative to the driver power."""
+    res = summary["driver_power"] - summary["load_power"] - summary["slip_power"]
+    return res, res / summary["driver_power"]
+
+
+def ladder(page: Page, quick: bool) -> list[dict]:
+    rungs = LADDERS[quick]
+    scene = _string()
+    page.para(
+        "The steady discrete state (`solve_steady`: Newton's method on the loop's "
+        "equations with the time derivatives zero, from the analytic state) of the string "
+        f"model of `{SCENE}` on a ladder of grids, each twice as fine as the last, against "
+        "the string's analytic steady state (`solve_string`). Errors are relative; the "
+        "speed loss 1 - speed ratio is compared as itself, the slip arcs relative to "
+        "their pulley's wrap. Commands: "
+        + _cmd("physics.model=string", "numerics.integrator=steady",
+               "numerics.elements=N") + f" for N in {', '.join(map(str, rungs))}.")
+    rows = []
+    for n in rungs:
+        r = solve_steady(scene, n)
+        rows.append({"elements": n, "h": _h(scene, n), "result": r, "errors": r.errors(),
+                     "balance": _balance(r.summary)})
+    body = [[str(r["elements"]), f"{r['h'] * 1e3:.4g}",
+             str(r["result"].statistics["newton_iterations"]),
+             fmt(r["result"].wall_time * 1e3, ".3g"),
+             *(fmt(r["errors"][k], ".3e") for k in ERRORS)] for r in rows]
+    page.table(["elements", "largest element [mm]", "Newton iterations", "wall [ms]",
+                *ERRORS.values()], body)
+    page.para("Observed orders in the element size, log(e1 / e2) / log(h1 / h2) for each "
+              "successive pair of grids, and the least-squares slope of log |e| against "
+              f"log h over the ladder. A fitted order below {MIN_ORDER:g} fails its cell "
+              "for the tensions, the speed loss and the slip arcs (the accuracy target); "
+              "the others are shown as measured. The driver's torque is exact to "
+              "round-off on every grid: at steady state the pulley's row and the loop's "
+              "momentum balance (the sum of the axial rows) give M1 = (R1 / R2) M2, as the "
+              "analytic state does.")
+    h = np.array([r["h"] for r in rows])
+    body = []
+    for key, title in ERRORS.items():
+        if key in EXACT_KEYS:
+            continue
+        e = np.abs([r["errors"][key] for r in rows])
+        ok = e > 0
+        if ok.sum() < 2:
+            body.append([title, "", "too few nonzero errors"])
+            continue
+        pairs = np.log(e[:-1] / e[1:]) / np.log(h[:-1] / h[1:])
+        fit = float(np.polyfit(np.log(h[ok]), np.log(e[ok]), 1)[0])
+        cell = f"{fit:.2f}"
+        if key in ORDER_KEYS and not fit >= MIN_ORDER:
+            cell = page.fail(f"steady ladder, {title}: fitted order {fit:.2f} < {MIN_ORDER:g}")
+        signs = "" if (np.all(np.array([r["errors"][key] for r in rows]) > 0)
+                       or np.all(np.array([r["errors"][key] for r in rows]) < 0)) \
+            else " (the error changes sign)"
+        body.append([title, ", ".join(f"{p:.2f}" for p in pairs), cell + signs])
+    page.table(["error", "successive pairs", "fitted"], body)
+    _figure(page, rows)
+    return rows
+
+
+def _figure(page: Page, rows) -> None:
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.5, 4.8), constrained_layout=True)
+    h = np.array([r["h"] for r in rows])
+    markers = "osD^v<>p"
+    # the belt speed's error lies on the speed loss's (both follow the tight tension)
+    shown = [(k, t) for k, t in ERRORS.items() if k not in EXACT_KEYS + ("belt_speed",)]
+    for (key, title), m in zip(shown, markers):
+        e = np.abs([r["errors"][key] for r in rows])
+        ok = e > 0
+        ax.loglog(h[ok], e[ok], marker=m, mfc="none", label=title)
+    top = max(abs(rows[0]["errors"][k]) for k in ORDER_KEYS)
+    ax.loglog(h, top * (h / h[0]) ** 2, "k:", label="order 2")
+    ax.set_xlabel("largest element [m]")
+    ax.set_ylabel("|error| against the string's analytic state")
+    ax.set_title(f"{SCENE}, string model: steady errors against the element size",
+                 fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    page.figure(fig, "convergence", f"{SCENE}, string model: relative errors of the steady "
+                "state against the largest element, with a second-order line")
+
+
+def default_grid(page: Page) -> None:
+    page.para(
+        f"The default grid has {DEFAULT_ELEMENTS} elements. The targets there: the "
+        f"tensions within {num(TENSION_TOL)} and the speed loss within "
+        f"{num(SPEED_LOSS_TOL)} (relative) of the analytic state, and a steady solve in "
+        f"at most {STEADY_WALL * 1e3:g} ms (best of {STEADY_REPEATS}, compilation "
+        f"excluded). Command: " + _cmd("physics.model=string",
+                                       "numerics.integrator=steady") + ".")
+    scene = _string()
+    best, r = np.inf, None
+    for _ in range(STEADY_REPEATS):
+        t0 = time.perf_counter()
+        r = solve_steady(scene)
+        best = min(best, time.perf_counter() - t0)
+    e = r.errors()
+    body = []
+    for key, tol in (("tight_tension", TENSION_TOL), ("slack_tension", TENSION_TOL),
+                     ("speed_loss", SPEED_LOSS_TOL)):
+        ok = abs(e[key]) <= tol
+        cell = "met" if ok else page.fail(f"default grid, {key}: {e[key]:.3e} beyond "
+                                          f"{num(tol)}")
+        body.append([ERRORS[key], f"{e[key]:.3e}", num(tol), cell])
+    body.append(["steady solve, wall [ms]", f"{best * 1e3:.3g}", f"{STEADY_WALL * 1e3:g}",
+                 "met" if best <= STEADY_WALL else "not met on this machine"])
+    page.table(["quantity", "measured", "target", ""], body)
+
+
+def startup(page: Page, quick: bool) -> None:
+    grid = [("numerics.elements", QUICK_ELEMENTS)] if quick else []
+    where = f"{QUICK_ELEMENTS} elements" if quick else "the default grid"
+    page.para(
+        f"Time-accurate runs from rest (c = omega2 = 0, uniform tension N0) on {where}: "
+        "the driver's speed and the load ramp up smoothly over two transits of the loop, "
+        "and the run stops when the drive is steady (`numerics.steady_tol`). Errors of "
+        "the end state against the analytic steady state the run compares with "
+        "(`DriveResult.analytic`: the string's for the string model; for the beam, the "
+        "beam's exact solution where beltsim has it, else the string's, which the beam "
+        "differs from by its shear and bending). The target: a default start-up in "
+        f"at most {STARTUP_WALL:g} s wall. Commands: `beltsim run {SCENE} --set "
+        f"physics.model=string` and `beltsim run {SCENE}` (the beam)"
+        + (f", with `--set numerics.elements={QUICK_ELEMENTS}`" if quick else "") + ".")
+    keys = ("tight_tension", "slack_tension", "speed_loss", "slip_arc_driver",
+            "slip_arc_driven", "slip_power")
+    body = []
+    for label, scene in (("string", _string(grid)), ("beam", shipped_scene(SCENE, grid))):
+        r = simulate(scene)
+        if r.converged:
+            status = "converged"
+        else:
+            status = page.fail(f"start-up, {label}: {r.status.value} ({r.reason})")
+        e = r.errors()
+        target = "met" if r.wall_time <= STARTUP_WALL else "not met on this machine"
+        body.append([label, type(r.analytic).__name__, status,
+                     fmt(float(r.history["t"][-1]), ".4g"), str(r.statistics["steps"]),
+                     str(r.statistics["newton_iterations"]),
+                     str(r.statistics["rejected_steps"]), f"{r.wall_time:.3g} ({target})",
+                     *(fmt(e.get(k), ".3e") for k in keys)])
+    page.table(["model", "compared with", "status", "end time [s]", "steps",
+                "Newton iterations", "rejected steps", "wall [s]",
+                *(ERRORS[k] for k in keys)], body)
+    if any(row[0] == "beam" and row[1] == "StringSolution" for row in body):
+        page.para("The beam's row is compared with the string's solution: its differences "
+                  "are the beam's own physics (the friction's moment about the middle line "
+                  "and the shear), mostly in the slip arcs, not the discretisation's error, "
+                  "which the string's row shows.")
+
+
+def threshold(page: Page, quick: bool) -> None:
+    grid = [("numerics.elements", QUICK_ELEMENTS)] if quick else []
+    scene = _string(grid)
+    cap = capacity(scene.params)
+    page.para(
+        f"The string's capacity at the driver's final speed is {cap:.6g} N m "
+        "(`capacity`: the load at which the slip arcs cover the smaller wrap). Runs from "
+        "rest of the string model at loads about it: below it the run must reach its "
+        "steady state, above it end in gross slip, and the steady solver must refuse the "
+        "load. Command: `beltsim run " + SCENE + " --set physics.model=string --set "
+        "drive.load_torque=M2" + (f" --set numerics.elements={QUICK_ELEMENTS}" if quick
+                                  else "") + "`.")
+    body = []
+    for frac in THRESHOLDS[quick]:
+        load = frac * cap
+        s = scene.with_overrides([("drive.load_torque", load)])
+        r = simulate(s)
+        expect = DriveStatus.CONVERGED if frac < 1 else DriveStatus.GROSS_SLIP
+        status = r.status.value if r.status is expect else page.fail(
+            f"threshold, {frac:g} x capacity: {r.status.value}, expected {expect.value}")
+        try:
+            exact = solve_string(s.params)
+            arc = f"{r.summary['slip_arc_driver']:.4f} / {exact.phi_s:.4f}"
+            steady = "solved"
+        except GrossSlipError as exc:
+            arc = f"{r.summary['slip_arc_driver']:.4f} / (none)"
+            steady = "refused: " + str(exc)
+        if frac > 1:
+            try:
+                solve_steady(s)
+                steady = page.fail(f"threshold, {frac:g} x capacity: the steady solver "
+                                   "did not refuse the load")
+            except GrossSlipError as exc:
+                steady = "refused: " + str(exc)
+        body.append([f"{frac:g}", f"{load:.5g}", status, r.reason or "",
+                     f"{float(r.history['t'][-1]):.4g}", arc, steady])
+    page.table(["load / capacity", "load [N m]", "status", "reason", "end time [s]",
+                "driver's slip arc, run / analytic [rad]", "steady solver"], body)
+
+
+def balance(page: Page, rows: list[dict], quick: bool) -> None:
+    page.para(
+        "At steady state the driver's power M1 omega1 equals the load's M2 omega2 plus "
+        "the slip power, the friction's dissipation -sum F_j v_rel,j over the contact "
+        "nodes (damping and the stored energies' rates vanish). The residual driver power "
+        "- load power - slip power of the steady states above falls with the grid. The "
+        "driver's torque is exact and the speeds' errors are tiny, so the residual is the "
+        "error of the slip power, the discrete friction's work, and falls at its order.")
+    body = [[str(r["elements"]), f"{r['result'].summary['driver_power']:.6g}",
+             f"{r['result'].summary['load_power']:.6g}",
+             f"{r['result'].summary['slip_power']:.6g}", f"{r['balance'][0]:.3e}",
+             f"{r['balance'][1]:.3e}",
+             f"{r['balance'][0] / r['result'].summary['slip_power']:.3e}"] for r in rows]
+    page.table(["elements", "driver power [W]", "load power [W]", "slip power [W]",
+                "residual [W]", "residual / driver power", "residual / slip power"], body)
+    data = _string().to_dict()
+    data["contact"] = {"friction": "stick"}
+    stick = DriveScene(data)
+    r = solve_steady(stick, QUICK_ELEMENTS if quick else None)
+    lost = r.summary["driver_power"] - r.summary["load_power"]
+    exact = r.analytic
+    page.para(
+        "Perfect adhesion (`contact.friction = \"stick\"`, the string model, "
+        f"{r.numerics.elements} elements): every node sticks, so the nodal slip power is "
+        f"{r.summary['slip_power']:.3g} W, yet the driver supplies "
+        f"{r.summary['driver_power']:.6g} W and the load takes "
+        f"{r.summary['load_power']:.6g} W. The difference, {lost:.6g} W, is the analytic "
+        f"creep loss kappa c dT^2 / b1 = {exact.slip_power:.6g} W (relative difference "
+        f"{(lost - exact.slip_power) / exact.slip_power:.2e}): it is dissipated by the "
+        "concentrated friction forces at the arcs' exits, where the belt's speed jumps, "
+        "and no nodal slip power records it.")
+
+
+def build(page: Page, quick: bool) -> None:
+    page.para(
+        f"The shipped `{SCENE}` scene (a flat belt on 80 and 160 mm pulleys, 150 rad/s, "
+        "50 N m, mu = 0.4) against the string's creep theory, the analytic steady state "
+        "derived on the [theory page](../theory/drive.md). Every table is computed "
+        "through beltsim's API; the commands give the same runs from the command line. "
+        "Wall times exclude compilation.")
+    page.heading("Steady convergence of the string model")
+    rows = ladder(page, quick)
+    page.heading("The default grid")
+    default_grid(page)
+    page.heading("A start-up from rest")
+    startup(page, quick)
+    page.heading("The gross-slip threshold")
+    threshold(page, quick)
+    page.heading("The power balance at steady state")
+    balance(page, rows, quick)
