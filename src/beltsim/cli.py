@@ -68,7 +68,8 @@ def _drive_run(args, scene):
     from .beltdrive.run import DriveStatus, simulate
 
     out = Path(args.out or Path("runs/out") / Path(args.scene).stem)
-    result = simulate(scene, snapshot_interval=args.snapshots)
+    result = simulate(scene, snapshot_interval=args.snapshots
+                      or scene.numerics.get("snapshot_interval"))
     save_drive_run(result, out)
     summary = result_summary(result)
     print(format_drive(summary, title=scene.title or args.scene))
@@ -77,7 +78,8 @@ def _drive_run(args, scene):
     if summary["error"]:
         print("  error vs exact   " + ", ".join(f"{k} {v:.2e}" for k, v in
                                               summary["error"].items()))
-    print(f"wrote {out}/summary.json, fields.csv, history.csv")
+    written = ["summary.json", "fields.csv"] + (["history.csv"] if result.history else [])
+    print(f"wrote {out}/" + ", ".join(written))
     if result.status is DriveStatus.FAILED:
         print(f"beltsim: numerical failure: {result.reason}", file=sys.stderr)
         return 3

@@ -102,6 +102,7 @@ class Layout:
 
 
 def layout_of(mesh: LoopMesh) -> Layout:
+    """The :class:`Layout` of a grid's unknowns."""
     N = len(mesh.x)
     lay = Layout(N, int(np.sum(mesh.lidx >= 0)))
     assert lay.size == n_unknowns(mesh)

@@ -1,7 +1,7 @@
 """The closed drive's discrete model once more, vectorised: the reference that
 :func:`beltsim.beltdrive.model.assemble` is checked against.
 
-Written from the equations of :mod:`.model`'s docstring, over all nodes at once: numpy
+Written from the equations of :mod:`beltsim.beltdrive.model`'s docstring, over all nodes at once: numpy
 with ``np.roll`` for the periodic neighbours (``np.roll(v, 1)[j] = v[j - 1]``) for the
 residual, and scipy.sparse operators for the Jacobian, composed block by block in the
 unknowns' field order (u, theta, lam, c, omega2) and then moved to the kernel's
@@ -111,7 +111,7 @@ def friction_scale(u, c, mesh: LoopMesh, p: LoopParams):
 def ratio_equation(lam, s, law: int):
     """(r, dr/dlam, dr/ds): the friction law's equation in the ratio lam and s = v_rel / v_s.
 
-    Exact Coulomb: lam - proj(lam + s) onto [-1, 1] (= -s where |lam + s| < 1); adhesion:
+    Exact Coulomb: lam - proj(lam + s) onto [-1, 1] (= -s where abs(lam + s) < 1); adhesion:
     -s; a regularised law lam = g(s): s - g^{-1}(lam).
     """
     if law not in _DRIVE_CODES:

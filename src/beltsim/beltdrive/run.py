@@ -221,7 +221,7 @@ def span_tensions(u, mesh: LoopMesh, P: DriveParams) -> tuple[float, float]:
 
 def slip_arcs(flds: dict, mesh: LoopMesh, P: DriveParams) -> tuple[float, float]:
     """The slip arc of each pulley (rad): the sliding nodes' contact lengths, plus the
-    share |lam| of the last sticking node's next to them (the front inside its volume:
+    share abs(lam) of the last sticking node's next to them (the front inside its volume:
     the node's friction is the integral over its volume, about mu p times the sliding
     part's length, so a front is located within a cell, not at its nodes)."""
     out = []
@@ -287,7 +287,7 @@ class DriveResult:
                 "driver_torque"]
         if self.scene.params.mu is not None:
             # with perfect adhesion every node sticks: the exits' dissipation is not a
-            # nodal slip power (see power_loss)
+            # nodal slip power but the transport term's (power_terms)
             keys.append("slip_power")
         for key in keys:
             out[key] = (self.summary[key] - ex[key]) / abs(ex[key]) if ex[key] else \
@@ -353,8 +353,9 @@ def solve_steady(scene: DriveScene, elements: int | None = None) -> DriveResult:
                   num.newton_max_iterations)
     wall = time.perf_counter() - start
     flds = fields_of(y, lay, mesh, P, prm, rim1)
-    return DriveResult(scene, num, DriveStatus.CONVERGED, None, mesh.x.copy(), flds,
-                       summary_of(y, flds, lay, mesh, P, P.M2, P.omega1, rim1),
+    final = summary_of(y, flds, lay, mesh, P, P.M2, P.omega1, rim1)
+    final.update(power_terms(y, flds, 0.0, lay, mesh, P, rim1, P.M2))
+    return DriveResult(scene, num, DriveStatus.CONVERGED, None, mesh.x.copy(), flds, final,
                        analytic=analytic_of(P), wall_time=wall,
                        statistics={"newton_iterations": its})
 
@@ -554,6 +555,7 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
     flds = fields_of(y, lay, mesh, P, prm, rim1,
                      None if not steps else (v_prev[0::2], v_prev[1::2]))
     final = summary_of(y, flds, lay, mesh, P, m2, rim1 / R1, rim1)
+    final.update(power_terms(y, flds, cdot if steps else 0.0, lay, mesh, P, rim1, m2))
     if snapshot_interval and (not snaps["t"] or snaps["t"][-1] < t):
         _snapshot(snaps, t, flds, final)
     try:

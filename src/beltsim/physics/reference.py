@@ -2,7 +2,7 @@
 
 numpy and scipy.sparse over all nodes at once, for the tests, the linear stability
 analysis (:mod:`.modes`) and the generic peers and numpy port in ``benchmarks/``. The
-semi-discrete model of :mod:`.model` reads
+semi-discrete model of :mod:`beltsim.physics.model` reads
 
     M q'' = f(q, q', t),   q = (u_1, theta_1, u_2, theta_2, ..., u_{N-1}, theta_{N-1}),
 
