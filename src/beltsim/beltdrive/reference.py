@@ -1,8 +1,8 @@
 """The closed drive's discrete model once more, vectorised: the reference that
 :func:`beltsim.beltdrive.model.assemble` is checked against.
 
-Written from the equations of :mod:`beltsim.beltdrive.model`'s docstring, over all nodes at once: numpy
-with ``np.roll`` for the periodic neighbours (``np.roll(v, 1)[j] = v[j - 1]``) for the
+Written from the equations of :mod:`beltsim.beltdrive.model`'s docstring, over all nodes
+at once: numpy with ``np.roll`` for the periodic neighbours (``np.roll(v, 1)[j] = v[j - 1]``) for the
 residual, and scipy.sparse operators for the Jacobian, composed block by block in the
 unknowns' field order (u, theta, lam, c, omega2) and then moved to the kernel's
 interleaved layout (:class:`beltsim.beltdrive.discrete.Layout`). The two share the grid,
