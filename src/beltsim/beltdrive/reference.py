@@ -3,8 +3,8 @@
 
 Written from the equations of :mod:`beltsim.beltdrive.model`'s docstring, over all nodes
 at once: numpy with ``np.roll`` for the periodic neighbours
-(``np.roll(v, 1)[j] = v[j - 1]``) for the residual, and scipy.sparse operators for the Jacobian, composed block by block in the
-unknowns' field order (u, theta, lam, c, omega2) and then moved to the kernel's
+(``np.roll(v, 1)[j] = v[j - 1]``) for the residual, and scipy.sparse operators for the
+Jacobian, composed block by block in the unknowns' field order (u, theta, lam, c, omega2) and then moved to the kernel's
 interleaved layout (:class:`beltsim.beltdrive.discrete.Layout`). The two share the grid,
 the coefficients and the layout, not the algebra.
 
