@@ -5,8 +5,9 @@ Written from the equations of :mod:`beltsim.beltdrive.model`'s docstring, over a
 at once: numpy with ``np.roll`` for the periodic neighbours
 (``np.roll(v, 1)[j] = v[j - 1]``) for the residual, and scipy.sparse operators for the
 Jacobian, composed block by block in the unknowns' field order (u, theta, lam, c,
-omega2) and then moved to the kernel's interleaved layout (:class:`beltsim.beltdrive.discrete.Layout`). The two share the grid,
-the coefficients and the layout, not the algebra.
+omega2) and then moved to the kernel's interleaved layout
+(:class:`beltsim.beltdrive.discrete.Layout`). The two share the grid, the coefficients
+and the layout, not the algebra.
 
 The discrete equations, with the local rates u_t = a0 u + hu, u_tt = a0 u_t + hv (theta
 alike with ht, hw), c_t = a0 c + hc, omega2_t = a0 omega2 + h2 and the periodic
