@@ -288,6 +288,73 @@ def balance(page: Page, rows: list[dict], quick: bool) -> None:
         "and no nodal slip power records it.")
 
 
+#: time tolerances of the path study and its reference (numerics.time_tol)
+TIME_TOLS = {False: (1e-3, 1e-4, 1e-5), True: (1e-3, 1e-4)}
+TIME_REFERENCE = {False: 1e-6, True: 1e-5}
+PATH_KEYS = ("tight_tension", "slack_tension", "belt_speed", "driven_speed")
+#: the path's target: within this of a run refined in time (relative to the steady value)
+PATH_TOL = 1e-3
+
+
+def _energy_mismatch(r) -> float:
+    """max over t of the stored energy minus the integrated power balance (trapezoidal
+    from rest), relative to the driver's work."""
+    H = r.history
+    t = np.concatenate([[0.0], H["t"]])
+    net = np.concatenate([[0.0], H["driver_power"] - H["load_power"] - H["slip_power"]
+                          - H["damping_power"] - H["gyroscopic_power"]
+                          + H["transport_power"]])
+    drive = np.concatenate([[0.0], H["driver_power"]])
+    integral = np.cumsum(0.5 * (net[1:] + net[:-1]) * np.diff(t))
+    work = float(np.sum(0.5 * (drive[1:] + drive[:-1]) * np.diff(t)))
+    return float(np.max(np.abs(H["energy"] - integral)) / work)
+
+
+def time_path(page: Page, quick: bool) -> None:
+    grid = [("numerics.elements", QUICK_ELEMENTS)] if quick else []
+    t_end = 0.5
+    common = [*grid, ("numerics.t_end", t_end), ("numerics.steady_tol", 1e-30)]
+    ref_tol = TIME_REFERENCE[quick]
+    page.para(
+        "The start-up's path in time: the beam model of the shipped scene from rest to "
+        f"t = {t_end:g} s with the adaptive BDF2 steps at several local-error tolerances "
+        f"`numerics.time_tol`, against a run at {ref_tol:g}. Path error: the largest "
+        "difference over t in [0.01, 0.5] s, relative to the steady value. The default "
+        f"tolerance is 1e-4; the target is a path within {PATH_TOL:g}. The last column is "
+        "the semi-discrete power balance over the run: the stored energy minus the "
+        "integral of driver - load - slip - damping - gyroscopic + transport power, "
+        "relative to the driver's work (`DriveResult.history`). Command: "
+        f"`beltsim run {SCENE} --set numerics.time_tol=TOL --set numerics.t_end={t_end:g}`.")
+    runs = {}
+    for tol in (*TIME_TOLS[quick], ref_tol):
+        start = time.perf_counter()
+        r = simulate(shipped_scene(SCENE, [*common, ("numerics.time_tol", tol)]))
+        runs[tol] = (r, time.perf_counter() - start)
+    ref = runs[ref_tol][0]
+    tt = np.linspace(0.01, t_end, 400)
+    body = []
+    for tol in TIME_TOLS[quick]:
+        r, wall = runs[tol]
+        errs = []
+        for k in PATH_KEYS:
+            a = np.interp(tt, r.history["t"], r.history[k])
+            b = np.interp(tt, ref.history["t"], ref.history[k])
+            errs.append(float(np.max(np.abs(a - b)) / abs(ref.summary[k])))
+        worst = max(errs)
+        if tol == 1e-4 and worst > PATH_TOL:
+            page.fail(f"the default time_tol's path error {worst:.2e} exceeds {PATH_TOL:g}")
+        body.append([f"{tol:g}", str(r.statistics["steps"]), str(r.statistics["rejected_steps"]),
+                     f"{wall:.3g}", *(f"{e:.2e}" for e in errs),
+                     f"{_energy_mismatch(r):.2e}"])
+    r, wall = runs[ref_tol]
+    body.append([f"{ref_tol:g} (reference)", str(r.statistics["steps"]),
+                 str(r.statistics["rejected_steps"]), f"{wall:.3g}", *("" for _ in PATH_KEYS),
+                 f"{_energy_mismatch(r):.2e}"])
+    page.table(["time_tol", "steps", "rejected", "wall [s]",
+                *(f"path error, {k.replace('_', ' ')}" for k in PATH_KEYS),
+                "power balance"], body)
+
+
 def build(page: Page, quick: bool) -> None:
     page.para(
         f"The shipped `{SCENE}` scene (a flat belt on 80 and 160 mm pulleys, 150 rad/s, "
@@ -301,6 +368,8 @@ def build(page: Page, quick: bool) -> None:
     default_grid(page)
     page.heading("A start-up from rest")
     startup(page, quick)
+    page.heading("The path in time")
+    time_path(page, quick)
     page.heading("The gross-slip threshold")
     threshold(page, quick)
     page.heading("The power balance at steady state")
