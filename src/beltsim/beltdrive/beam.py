@@ -65,10 +65,18 @@ from . import analytic
 from .analytic import GrossSlipError, LiftOffError, solve_string
 from .scene import DriveParams
 
-#: Newton stops when its scaled step falls below this.
+#: Newton stops when its scaled step falls below this ...
 STEP_TOL = 1e-13
-#: Newton iterations at most (a start from the string converges in a handful).
-MAX_ITERATIONS = 60
+#: ... or below this where no step lowers the residual (its round-off floor).
+FLOOR_STEP = 1e-7
+#: Newton iterations at most (a start from the string converges in a handful) ...
+MAX_ITERATIONS = 30
+#: ... and damped steps (below 1/8 of Newton's) in a row before it gives up.
+MAX_DAMPED = 4
+#: A load continuation that stalls with the slack side's N - rho c^2 below this fraction of
+#: the tight side's is taken for lift-off: the slip arcs grow as ln(1 / p) there and, with
+#: a large mu, reach the wrap only as p -> 0.
+LIFT_OFF_MARGIN = 0.05
 #: Gauss-Legendre points on each piece of the graded quadrature.
 _GAUSS = np.polynomial.legendre.leggauss(16)
 
@@ -139,12 +147,14 @@ class _Loop:
         if not self.B > 0:
             raise NoSolutionError(f"drive.driver_speed: the belt speed {c:.6g} m/s reaches "
                                   f"the critical speed sqrt(b1 / rho)")
-        if not self.A > 0:
+        if not self.A > 0 and lever > 0:
             raise NoSolutionError(f"drive.driver_speed: at the belt speed {c:.6g} m/s the "
                                   f"rotary inertia outweighs the bending stiffness "
                                   f"(a - I c^2 <= 0): no steady beam solution")
-        self.beta = math.sqrt(P.b2 / self.A)
-        self.alpha = math.sqrt(P.b2 / (self.A + lever * lever * self.B))
+        # without a lever theta is not forced and vanishes: any decay rate serves
+        A = self.A if self.A > 0 else P.a
+        self.beta = math.sqrt(P.b2 / A)
+        self.alpha = math.sqrt(P.b2 / (A + lever * lever * self.B))
         self.coulomb = d is not None
         e = g.bounds
         segs = []
@@ -231,6 +241,13 @@ class _Loop:
             return seg.sign * self.P.mu / R * n
         return self._zero(t)
 
+    def pressure(self, i, t):
+        """The contact pressure (N - rho c^2) / R on arc piece i at local t."""
+        R = self.P.geometry.radii[self.segs[i].arc]
+        out = self.P.b1 / R * self.eps(i, t)
+        out[:, -1] += (self.P.N0 - self.rc) / R
+        return out
+
     def fibre_speed(self, i, t):
         """The bottom fibre's speed c (1 + N0/b1 + eps + l theta') on piece i at t."""
         out = self.c * (self.eps(i, t) + self.l * self.theta(i, t, 1))
@@ -307,56 +324,68 @@ def _unpack(P, mode, y):
 
 
 def _newton(P, lever, omega1, M2, mode, y0):
-    """Newton with a central-difference Jacobian and backtracking; returns (loop, z, y)."""
+    """Damped Newton on the closing residuals with a central-difference Jacobian; the
+    unknowns other than c (slip-arc variables, a load) are kept >= 0.
+
+    Converged when the scaled step falls below STEP_TOL, or below FLOOR_STEP where no
+    step lowers the residual any more (its round-off floor, which the exponentials'
+    range raises when the slack side's pressure nearly vanishes). Returns (loop, z, y).
+    """
     y = np.array(y0, dtype=float)
     scale = np.array([y[0]] + [1.0] * (len(y) - 1))
 
-    def resid(y):
+    def evaluate(y):
         c, d, m2 = _unpack(P, mode, y)
-        loop = _Loop(P, lever, c, d)
-        z, r = loop.solve(omega1, M2 if m2 is None else m2)
-        return loop, z, r / P.N0
-
-    def norm(y):
         try:
-            r = resid(y)[2]
-        except (NoSolutionError, np.linalg.LinAlgError, FloatingPointError):
-            return math.inf
-        return float(np.linalg.norm(r)) if np.all(np.isfinite(r)) else math.inf
+            with np.errstate(all="ignore"):
+                loop = _Loop(P, lever, c, d)
+                z, r = loop.solve(omega1, M2 if m2 is None else m2)
+        except (NoSolutionError, np.linalg.LinAlgError):
+            return None
+        r = r / P.N0
+        return (loop, z, r) if np.all(np.isfinite(r)) and np.all(np.isfinite(z)) else None
 
-    try:
-        r = resid(y)[2]
-    except (NoSolutionError, np.linalg.LinAlgError) as exc:
-        raise _NotConverged(str(exc)) from None
+    current = evaluate(y)
+    if current is None:
+        raise _NotConverged("no state at the start")
+    damped = 0
     for _ in range(MAX_ITERATIONS):
+        r = current[2]
         J = np.empty((len(r), len(y)))
         for j in range(len(y)):
             h = 1e-6 * scale[j]
             yp, ym = y.copy(), y.copy()
             yp[j] += h
             ym[j] -= h
-            try:
-                J[:, j] = (resid(yp)[2] - resid(ym)[2]) / (2 * h)
-            except (NoSolutionError, np.linalg.LinAlgError) as exc:
-                raise _NotConverged(str(exc)) from None
+            ep, em = evaluate(yp), evaluate(ym)
+            if ep is None or em is None:
+                raise _NotConverged("no state near the iterate")
+            J[:, j] = (ep[2] - em[2]) / (2 * h)
         try:
             dy = np.linalg.solve(J, -r)
         except np.linalg.LinAlgError:
             raise _NotConverged("singular Jacobian") from None
-        n0, step = float(np.linalg.norm(r)), 1.0
-        while True:
+        n0, step, new = float(np.linalg.norm(r)), 1.0, None
+        while step >= 1e-4:
             trial = y + step * dy
-            if norm(trial) < (1.0 - 1e-4 * step) * n0 or step < 1e-3:
+            trial[1:] = np.maximum(trial[1:], 0.0)
+            new = evaluate(trial)
+            if new is not None and float(np.linalg.norm(new[2])) < (1 - 1e-4 * step) * n0:
                 break
+            new = None
             step /= 2
-        size = float(np.max(np.abs(step * dy) / scale))
-        if not math.isfinite(norm(trial)):
-            raise _NotConverged("the iterate left the model's domain")
-        y = trial
-        r = resid(y)[2]
-        if size < STEP_TOL or (size < 1e-9 and float(np.linalg.norm(r)) >= n0):
-            loop, z, _ = resid(y)
-            return loop, z, y
+        size = float(np.max(np.abs(dy) / scale))
+        if new is None:
+            if size < FLOOR_STEP and n0 < 1e-6:
+                return current[0], current[1], y
+            raise _NotConverged("no step lowers the residual")
+        size = float(np.max(np.abs(trial - y) / scale))
+        y, current = trial, new
+        if size < STEP_TOL:
+            return current[0], current[1], y
+        damped = damped + 1 if step < 0.125 else 0
+        if damped >= MAX_DAMPED:
+            raise _NotConverged("Newton stalls on damped steps")
     raise _NotConverged(f"no convergence in {MAX_ITERATIONS} iterations")
 
 
@@ -376,7 +405,7 @@ def _converge(P, omega1, M2, mode, y0):
             loop, z, y_new = _newton(P, (t + dt) * lever, omega1, M2, mode, y)
         except _NotConverged:
             dt /= 2
-            if dt < 1e-3:
+            if dt < 1.0 / 16:
                 raise
             continue
         t, y, dt = t + dt, y_new, 2 * dt
@@ -624,12 +653,11 @@ class BeamSolution:
         loop, P, g = self._loop, self.P, self.P.geometry
         names = ("driver", "driven")
         for arc in (0, 1):
-            R = g.radii[arc]
             for i, seg in enumerate(loop.segs):
                 if seg.arc != arc:
                     continue
                 t = np.concatenate([[0.0, seg.length], _graded(seg)[0]])
-                p = (P.N0 + P.b1 * (loop.eps(i, t) @ self._zz) - loop.rc) / R
+                p = loop.pressure(i, t) @ self._zz
                 if not np.min(p) > 0:
                     raise LiftOffError(
                         f"drive.installation_tension: {P.N0:g} N leaves the {names[arc]} arc "
@@ -696,32 +724,139 @@ def _defaults(P, omega1, M2):
     return omega1, M2
 
 
-def _capacity_state(P: DriveParams, omega1: float):
-    """(capacity, loop, z): the load at which a slip arc first covers its whole wrap."""
+def _check_bending(P: DriveParams, omega1: float):
+    """Refuse a drive whose belt, near the rim speed, has A = a - I c^2 <= 0: there theta's
+    equation loses its decaying solutions and the beam has no steady state."""
+    c = omega1 * P.geometry.R1 / (1.0 + P.N0 / P.b1)  # the unloaded belt speed
+    if P.lever > 0 and not P.a - P.I * c * c > 0:
+        raise NoSolutionError(
+            f"drive.driver_speed: at the belt speed {c:.6g} m/s the rotary inertia I c^2 = "
+            f"{P.I * c * c:.4g} N m^2 reaches the bending stiffness a = {P.a:.4g} N m^2: "
+            f"the beam has no steady state (a - I c^2 <= 0)")
+
+
+def _fits(P: DriveParams, d) -> bool:
+    """Whether both slip arcs of lengths d (m) lie within their wraps."""
+    return all(d[k] <= P.geometry.arcs[k] for k in (0, 1))
+
+
+def _string_start(P: DriveParams, omega1: float, M2: float):
+    """The iterated unknowns (c, w1, w2) of the string's state, or None where the string
+    has none (its gross slip or lift-off, or its root bracket failing near lift-off)."""
+    try:
+        s = solve_string(P, omega1, M2)
+    except ValueError:  # NoSolutionError included
+        return None
+    return s.c, P.mu * s.phi_s, P.mu * s.phi_s
+
+
+def _lowest_pressure(loop: _Loop, z) -> float:
+    """The smallest contact pressure (N/m) on the arcs (the pieces' ends and the graded
+    quadrature's nodes)."""
+    zz = np.append(z, 1.0)
+    low = math.inf
+    for i, seg in enumerate(loop.segs):
+        if seg.arc >= 0:
+            t = np.concatenate([[0.0, seg.length], _graded(seg)[0]])
+            low = min(low, float(np.min(loop.pressure(i, t) @ zz)))
+    return low
+
+
+def _march(P: DriveParams, omega1: float, target: float):
+    """Continuation in the load from the unloaded drive (exact: uniform strain, c from the
+    driver's rim, no slip) towards ``target`` (may be inf), the step doubling while Newton
+    converges to an admissible state (both slip arcs inside their wraps, the pressure
+    positive) and halving otherwise.
+
+    Returns
+    -------
+    (M, y, found, status)
+        The last load reached, its unknowns and its (loop, z) (None if only the unloaded
+        drive); ``status`` "done" (M is the target), "over" (a slip arc leaves its wrap
+        beyond M), "lift" (the pressure vanishes beyond M) or "stall" (Newton fails).
+    """
     g = P.geometry
-    cap_s = analytic.capacity(P, omega1)
-    s = solve_string(P, omega1, cap_s * (1.0 - 1e-9))
-    w = P.mu * s.phi_s
-    order = ("cap1", "cap2") if g.wraps[0] <= g.wraps[1] else ("cap2", "cap1")
-    best, failures = None, []
-    for mode in order:
-        y0 = (s.c, cap_s / (g.R2 * P.N0), w) if mode == "cap1" else \
-            (s.c, w, cap_s / (g.R2 * P.N0))
+    c0 = omega1 * g.R1 / (1.0 + P.N0 / P.b1)
+    if not P.N0 > P.rho * c0 * c0:
+        return 0.0, None, None, "lift"
+    M, y = 0.0, np.array([c0, 0.0, 0.0])
+    dM = min(target, 0.1 * g.R2 * P.N0)
+    found, status = None, "stall"
+    while M < target:
+        trial = min(M + dM, target)
         try:
-            loop, z, y = _converge(P, omega1, 0.0, mode, y0)
+            loop, z, y_new = _newton(P, P.lever, omega1, trial, "load", y)
+            ok = _fits(P, _unpack(P, "load", y_new)[1]) or "over"
+            if ok is True and not _lowest_pressure(loop, z) > 0:
+                ok = "lift"
+        except _NotConverged:
+            ok = "stall"
+        if ok is True:
+            M, y, found = trial, y_new, (loop, z)
+            if status == "stall":
+                dM *= 2
+            continue
+        if status == "stall":
+            status = ok
+        dM /= 2
+        if dM < 1e-3 * M or dM < 1e-9 * g.R2 * P.N0:
+            if status == "stall" and found is not None and _margin(found) < LIFT_OFF_MARGIN:
+                status = "lift"  # Newton fails as the slack side's pressure vanishes
+            return M, y, found, status
+    return M, y, found, "done"
+
+
+def _capacity_near(P: DriveParams, omega1: float, M: float, y):
+    """(capacity, loop, z) by Newton with a slip arc pinned to its whole wrap and the load
+    unknown, started from an admissible state (load M, unknowns y) close below it."""
+    g = P.geometry
+    c, d, _ = _unpack(P, "load", y)
+    w = (y[1], y[2])
+    first = 0 if d[0] / g.arcs[0] >= d[1] / g.arcs[1] else 1
+    failures = []
+    for arc in (first, 1 - first):
+        mode = ("cap1", "cap2")[arc]
+        y0 = [c, w[0], w[1]]
+        y0[1 + arc] = M / (g.R2 * P.N0)
+        try:
+            loop, z, y_cap = _newton(P, P.lever, omega1, 0.0, mode, y0)
         except (_NotConverged, NoSolutionError) as exc:
             failures.append(str(exc))
             continue
-        _, d, m2 = _unpack(P, mode, y)
-        other = 1 if mode == "cap1" else 0
-        if d[other] <= g.arcs[other] * (1.0 + 1e-12) and (best is None or m2 < best[0]):
-            best = (m2, loop, z)
-            if g.wraps[0] != g.wraps[1]:
-                break
-    if best is None:
-        raise NoSolutionError(f"beam drive: no capacity found at {omega1:g} rad/s "
-                              f"({'; '.join(failures) or 'no slip arc fits its wrap'})")
-    return best
+        _, d_cap, cap = _unpack(P, mode, y_cap)
+        if d_cap[1 - arc] <= g.arcs[1 - arc] * (1.0 + 1e-12):
+            return cap, loop, z
+    raise NoSolutionError(f"beam drive: no capacity found at {omega1:g} rad/s "
+                          f"({'; '.join(failures) or 'no slip arc fits its wrap'})")
+
+
+def _capacity_by_string(P: DriveParams, omega1: float):
+    """(capacity, loop, z) started from the string's state just below the string's
+    capacity (the two differ by O(l)), or None where the string gives no such state."""
+    try:
+        cap_s = analytic.capacity(P, omega1)
+    except ValueError:  # the string's bracket can fail where the belt lifts off
+        return None
+    start = _string_start(P, omega1, cap_s * (1.0 - 1e-9))
+    if start is None:
+        return None
+    try:
+        return _capacity_near(P, omega1, cap_s, np.array(start))
+    except NoSolutionError:
+        return None
+
+
+def _capacity_state(P: DriveParams, omega1: float):
+    """(capacity, loop, z): the load at which a slip arc first covers its whole wrap; from
+    the string's capacity, else from the end of a load continuation."""
+    found = _capacity_by_string(P, omega1)
+    if found is not None:
+        return found
+    M, y, _, status = _march(P, omega1, math.inf)
+    if status != "over":
+        raise NoSolutionError(f"beam drive: no capacity found at {omega1:g} rad/s (the "
+                              f"load continuation stops at {M:.6g} N m before gross slip)")
+    return _capacity_near(P, omega1, M, y)
 
 
 def capacity(P: DriveParams, omega1: float | None = None) -> float:
@@ -734,6 +869,7 @@ def capacity(P: DriveParams, omega1: float | None = None) -> float:
     if P.mu is None:
         return math.inf
     omega1, _ = _defaults(P, omega1, 0.0)
+    _check_bending(P, omega1)
     return float(_capacity_state(P, omega1)[0])
 
 
@@ -743,10 +879,64 @@ def _gross_slip(P, omega1, M2, cap):
                           cap)
 
 
+def _solve_coulomb(P: DriveParams, omega1: float, M2: float):
+    """(loop, z) of the Coulomb solution, or GrossSlipError / NoSolutionError."""
+    start = _string_start(P, omega1, M2)
+    if start is not None:
+        try:
+            loop, z, y = _converge(P, omega1, M2, "load", start)
+            if _fits(P, _unpack(P, "load", y)[1]):
+                return loop, z
+        except _NotConverged:
+            pass
+    # near or beyond the capacity: the beam's capacity from the string's, and below it a
+    # start from the capacity state
+    found = _capacity_by_string(P, omega1)
+    if found is not None:
+        cap, loop, _ = found
+        if M2 > cap:
+            raise _gross_slip(P, omega1, M2, cap)
+        d = [seg.length for seg in loop.segs if seg.kind == "slip"]
+        try:
+            loop, z, y = _newton(P, P.lever, omega1, M2, "load",
+                                 (loop.c, d[0] * P.mu / P.geometry.R1,
+                                  d[1] * P.mu / P.geometry.R2))
+            if _fits(P, _unpack(P, "load", y)[1]):
+                return loop, z
+        except _NotConverged:
+            pass
+    M, y, found, status = _march(P, omega1, M2)
+    if status == "done":
+        return found
+    if status == "over":
+        cap = _capacity_near(P, omega1, M, y)[0]
+        if M2 > cap:
+            raise _gross_slip(P, omega1, M2, cap)
+    elif status == "lift":
+        raise LiftOffError(
+            f"drive.installation_tension: {P.N0:g} N leaves the belt without contact "
+            f"pressure beyond {M:.4g} N m, below the load {M2:g} N m: it would lift off, "
+            f"which this model does not describe")
+    raise NoSolutionError(f"beam drive: no steady state found at {M2:g} N m (the load "
+                          f"continuation stops at {M:.6g} N m)")
+
+
+def _margin(found) -> float:
+    """(T2 - rho c^2) / (T1 - rho c^2) of a state (loop, z): the slack side's share."""
+    loop, z = found
+    zz = np.append(z, 1.0)
+    n = [float(loop.pressure(i, 0.0)[0] @ zz) * loop.P.geometry.radii[seg.arc]
+         for i, seg in enumerate(loop.segs) if seg.kind == "stick"]
+    return n[1] / n[0]
+
+
 def solve_beam(P: DriveParams, omega1: float | None = None,
                M2: float | None = None) -> BeamSolution:
     """The shear-deformable beam's steady state at driver speed omega1 and load M2 (the
     scene's final values by default); ``P.lever`` = 0 (the string model) gives the string.
+
+    Newton starts from the string's closed-form state; where that fails, from a
+    continuation in the load.
 
     Raises
     ------
@@ -759,45 +949,18 @@ def solve_beam(P: DriveParams, omega1: float | None = None,
     """
     omega1, M2 = _defaults(P, omega1, M2)
     g = P.geometry
+    _check_bending(P, omega1)
     if P.mu is None:
         try:
             c0 = solve_string(P, omega1, M2).c
-        except LiftOffError:
+        except ValueError:  # the string lifts off: start from the unloaded belt speed
             c0 = omega1 * g.R1 / (1.0 + P.N0 / P.b1)
         try:
             loop, z, _ = _converge(P, omega1, M2, "stick", (c0,))
         except _NotConverged as exc:
             raise NoSolutionError(f"beam drive: no steady state found ({exc})") from None
-        sol = BeamSolution(P, omega1, M2, loop, z)
-        sol._check()
-        return sol
-    start = None
-    try:
-        s = solve_string(P, omega1, M2)
-        start = (s.c, P.mu * s.phi_s, P.mu * s.phi_s)
-    except GrossSlipError:
-        pass
-    if start is not None:
-        try:
-            loop, z, y = _converge(P, omega1, M2, "load", start)
-            _, d, _ = _unpack(P, "load", y)
-            if all(d[k] <= g.arcs[k] for k in (0, 1)):
-                sol = BeamSolution(P, omega1, M2, loop, z)
-                sol._check()
-                return sol
-        except _NotConverged:
-            pass
-    cap, cap_loop, cap_z = _capacity_state(P, omega1)
-    if M2 > cap:
-        raise _gross_slip(P, omega1, M2, cap)
-    # within the beam's capacity but not from the string's start: from the capacity state
-    d = [seg.length for seg in cap_loop.segs if seg.kind == "slip"]
-    y0 = (cap_loop.c, d[0] * P.mu / g.R1, d[1] * P.mu / g.R2)
-    try:
-        loop, z, _ = _converge(P, omega1, M2, "load", y0)
-    except _NotConverged as exc:
-        raise NoSolutionError(f"beam drive: no steady state found below the capacity "
-                              f"{cap:.6g} N m ({exc})") from None
+    else:
+        loop, z = _solve_coulomb(P, omega1, M2)
     sol = BeamSolution(P, omega1, M2, loop, z)
     sol._check()
     return sol
