@@ -33,10 +33,18 @@ span, e_1 and e_2). Its 21 conditions are the continuity of theta, theta' and ep
 interfaces, the fixed length (integral of eps over the loop = 0), the driven pulley's
 balance (integral of f over its arc = -M2/R2) and e_1's definition by c. Eighteen of them
 fix the constants; the other three (the strain's continuity where the loop closes at x = 0,
-the length and the balance) are the residuals of a Newton iteration on (c, d_1, d_2),
-started from the string's closed-form solution. Perfect adhesion (mu None) sticks on the
-whole arc, with a concentrated force F_i at each exit where [[B eps]] = -F_i and
-[[A theta']] = -l F_i; then only c is iterated. omega_2 follows from e_2.
+the length and the balance) are the residuals of a damped Newton iteration on (c, d_1, d_2).
+Perfect adhesion (mu None) sticks on the whole arc, with a concentrated force F_i at each
+exit where [[B eps]] = -F_i and [[A theta']] = -l F_i; then only c is iterated. omega_2
+follows from e_2.
+
+Starts. Newton starts from the string's closed-form state (exact at l = 0, so a
+continuation in l backs it up); near the capacity from the beam's capacity state; failing
+both, from a continuation in the load from the unloaded drive (uniform strain, no slip),
+which also tells gross slip (a slip arc leaves its wrap) from lift-off (the continuation
+stalls as the slack side's pressure vanishes). Where the tension ratio across the slip
+arcs is huge (the slack side nearly without pressure) the exponentials' range raises the
+residual's round-off floor, and Newton stops there (FLOOR_STEP).
 
 Power. Multiplying B eps' + f = 0 by eps and the moment balance by theta' and integrating
 over the loop (periodic fields) gives integral f (eps + l theta') = 0, and integral f = 0,
@@ -147,10 +155,9 @@ class _Loop:
         if not self.B > 0:
             raise NoSolutionError(f"drive.driver_speed: the belt speed {c:.6g} m/s reaches "
                                   f"the critical speed sqrt(b1 / rho)")
-        if not self.A > 0 and lever > 0:
-            raise NoSolutionError(f"drive.driver_speed: at the belt speed {c:.6g} m/s the "
-                                  f"rotary inertia outweighs the bending stiffness "
-                                  f"(a - I c^2 <= 0): no steady beam solution")
+        if not self.A > 0 and lever > 0:  # solve_beam refuses such drives up front
+            raise NoSolutionError(f"drive.driver_speed: a - I c^2 <= 0 at the belt speed "
+                                  f"{c:.6g} m/s")
         # without a lever theta is not forced and vanishes: any decay rate serves
         A = self.A if self.A > 0 else P.a
         self.beta = math.sqrt(P.b2 / A)
@@ -544,7 +551,8 @@ class BeamSolution:
 
     @property
     def tight_tension(self) -> float:
-        """The mean axial force N (N) over the tight span."""
+        """The mean axial force N (N) over the tight span (constant there: no friction acts
+        on a span, so B eps' = 0; theta's boundary layers at its ends leave N alone)."""
         return self._span_mean(len(self._loop.segs) - 1)
 
     @property
@@ -555,13 +563,14 @@ class BeamSolution:
     def summary(self) -> dict:
         """The drive's figures, under the run summary's names."""
         arcs = self.slip_arcs
-        return {
+        out = {
             "tight_tension": self.tight_tension, "slack_tension": self.slack_tension,
             "belt_speed": self.c, "driven_speed": self.omega2,
             "speed_ratio": self.speed_ratio, "slip_arc_driver": arcs[0],
             "slip_arc_driven": arcs[1], "driver_torque": self.driver_torque,
             "efficiency": self.efficiency, "slip_power": self.slip_power,
         }
+        return {k: float(v) for k, v in out.items()}
 
     # fields ------------------------------------------------------------------------
     def _field(self, x, name):
