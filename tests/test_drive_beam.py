@@ -50,6 +50,7 @@ def _left(fun, x, d=1e-7):
 
 
 def _quad(fun, a, b, points, epsabs=0.0):
+    """The integral of fun over [a, b], split at the points inside (scipy quad)."""
     inner = [p for p in points if a < p < b]
     val, _ = quad(fun, a, b, points=inner or None, limit=2000, epsabs=epsabs, epsrel=1e-13)
     return val
@@ -185,6 +186,25 @@ def test_string_model_is_the_closed_form_string(friction, inertia):
     u = ref.displacement(x)
     np.testing.assert_allclose(sol.displacement(x), u, rtol=0, atol=1e-10 * np.max(np.abs(u)))
     assert np.all(sol.theta(x) == 0.0)
+
+
+@pytest.mark.parametrize("inertia", [True, False])
+def test_adhesion_spans_and_speeds_are_the_strings(inertia):
+    """Perfect adhesion: theta's boundary layer at each exit has theta(e) = l F_i /
+    (A (alpha + beta)), the same decay rates on both pulleys and F_2 = -F_1, so the
+    length integrals' l theta terms cancel between the exits and the spans' tensions, c
+    and omega2 are the string's (up to exp(-beta span), nil here), while the concentrated
+    forces are smaller: part of the friction spreads over the stick zones' layers."""
+    P = _scene("stick", inertia).params
+    sol, ref = beam.solve_beam(P), analytic.solve_string(P)
+    for key in ("tight_tension", "slack_tension", "belt_speed", "driven_speed"):
+        assert sol.summary()[key] == pytest.approx(ref.summary()[key], rel=1e-12), key
+    F, F_string = sol.concentrated, ref.concentrated
+    assert F[0] == pytest.approx(-F[1], rel=1e-12)
+    assert 0 < F[0] < 0.9 * F_string[0]
+    B, A, alpha, beta, lever = _coefficients(P, sol)
+    exit1 = P.geometry.bounds[1]
+    assert sol.theta(exit1) == pytest.approx(lever * F[0] / (A * (alpha + beta)), rel=1e-9)
 
 
 @pytest.mark.parametrize("inertia", [True, False])
