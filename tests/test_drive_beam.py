@@ -335,6 +335,8 @@ def test_lift_off_and_bad_arguments():
     assert beam.solve_beam(sticky, M2=200.0).slack_tension > 0
     with pytest.raises(analytic.LiftOffError, match="drive.installation_tension"):
         beam.solve_beam(sticky, M2=240.0)
+    with pytest.raises(analytic.LiftOffError, match="lifts off even unloaded"):
+        beam.solve_beam(dataclasses.replace(sticky, N0=30.0))  # rho c^2 = 41 N
     with pytest.raises(NoSolutionError, match=r"drive.driver_speed: .*\(a - I c\^2 <= 0\)"):
         beam.solve_beam(_scene().params, omega1=600.0)
     with pytest.raises(ValueError, match="omega1: must be > 0"):

@@ -921,6 +921,12 @@ def _solve_coulomb(P: DriveParams, omega1: float, M2: float):
         cap = _capacity_near(P, omega1, M, y)[0]
         if M2 > cap:
             raise _gross_slip(P, omega1, M2, cap)
+    elif status == "lift" and not P.N0 > P.rho * (omega1 * P.geometry.R1) ** 2 / (
+            1.0 + P.N0 / P.b1) ** 2:
+        c0 = omega1 * P.geometry.R1 / (1.0 + P.N0 / P.b1)
+        raise LiftOffError(
+            f"drive.installation_tension: {P.N0:g} N does not exceed the centrifugal "
+            f"tension rho c^2 = {P.rho * c0 * c0:.4g} N: the belt lifts off even unloaded")
     elif status == "lift":
         raise LiftOffError(
             f"drive.installation_tension: {P.N0:g} N leaves the belt without contact "
