@@ -220,20 +220,35 @@ def span_tensions(u, mesh: LoopMesh, P: DriveParams) -> tuple[float, float]:
 
 
 def slip_arcs(flds: dict, mesh: LoopMesh, P: DriveParams) -> tuple[float, float]:
-    """The slip arc of each pulley (rad): the sliding nodes' contact lengths, plus the
-    share abs(lam) of the last sticking node's next to them (the front inside its volume:
-    the node's friction is the integral over its volume, about mu p times the sliding
-    part's length, so a front is located within a cell, not at its nodes)."""
+    """The slip arc of each pulley (rad): the sliding nodes' contact lengths plus the
+    sliding share of the last sticking node next to them.
+
+    A node's friction is the integral of f over its volume. With the front inside the
+    volume of the last sticking node j, a share phi of it slides (ratio +-1) and the rest
+    sticks with the stick zone's ratio lam_s, so lam_j = (1 - phi) lam_s + phi sign:
+    phi = (lam_j - lam_s) / (sign - lam_s), with lam_s extrapolated linearly from the two
+    sticking nodes upstream (zero for the string, whose stick zones carry no friction).
+    The front is then located within a cell, not at its nodes.
+    """
     out = []
+    lam = flds["ratio"]
+    N = len(mesh.x)
     for a, R in ((0, P.geometry.R1), (1, P.geometry.R2)):
         js = np.flatnonzero(mesh.arc == a)
         slip = flds["slip"][js]
         length = float(np.sum(mesh.wf[js][slip]))
-        # the last sticking node upstream of the slip run next to the exit
-        prev = (js[slip] - 1) % len(mesh.x)
-        edge = [j for j in prev if mesh.arc[j] == a and not flds["slip"][j]]
-        for j in edge:
-            length += mesh.wf[j] * abs(flds["ratio"][j])
+        for j in (js[slip] - 1) % N:
+            if mesh.arc[j] != a or flds["slip"][j]:
+                continue  # not the sticking node in front of a sliding run
+            sign = math.copysign(1.0, lam[(j + 1) % N])
+            j1, j2 = (j - 1) % N, (j - 2) % N
+            lam_s = 0.0
+            if mesh.arc[j1] == a and mesh.arc[j2] == a and not (flds["slip"][j1]
+                                                                 or flds["slip"][j2]):
+                lam_s = 2.0 * lam[j1] - lam[j2]
+            if sign != lam_s:
+                phi = min(1.0, max(0.0, (lam[j] - lam_s) / (sign - lam_s)))
+                length += mesh.wf[j] * phi
         out.append(length / R)
     return out[0], out[1]
 

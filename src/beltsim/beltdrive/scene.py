@@ -215,6 +215,11 @@ def validate(data: dict) -> dict:
     if P.rho > 0 and max_rim_speed(out) ** 2 * P.rho >= P.b1:
         raise SceneError("drive.driver_speed", f"the rim speed reaches the belt's critical "
                          f"speed sqrt(b1 / rho) = {math.sqrt(P.b1 / P.rho):.4g} m/s")
+    if P.model == "beam" and P.I > 0 and max_rim_speed(out) ** 2 * P.I >= P.a:
+        raise SceneError("drive.driver_speed", f"the rim speed reaches the beam's bending "
+                         f"critical speed sqrt(a / I) = {math.sqrt(P.a / P.I):.4g} m/s "
+                         f'(a - I c^2 <= 0: no steady state; physics.model = "string" has '
+                         f"none)")
     from .analytic import LiftOffError, solve_string
 
     try:
