@@ -334,3 +334,34 @@ def test_steady_beam_converges_to_the_beams_exact_state():
     fine = solve_steady(scene, 3200).errors()
     for k in ("slip_arc_driver", "slip_arc_driven"):
         assert abs(fine[k]) < 2e-4 and abs(fine[k]) < abs(coarse[k]) / 5
+
+
+@pytest.mark.verification
+def test_explicit_scheme_ends_on_the_steady_schemes_state():
+    """The explicit scheme's fixed point is the semi-discrete steady state (measured on 200
+    elements: tensions and speeds within 2e-8 of solve_steady's, the slip arcs equal)."""
+    scene = flat(STRING, ("numerics.elements", 200))
+    r = simulate(scene.with_overrides([("numerics.integrator", "explicit")]))
+    assert r.status is DriveStatus.CONVERGED
+    ref = solve_steady(scene)
+    for k in ("tight_tension", "slack_tension", "belt_speed", "driven_speed",
+              "slip_arc_driver", "slip_arc_driven"):
+        assert r.summary[k] == pytest.approx(ref.summary[k], rel=1e-6), k
+    # and it starts from rest like the implicit scheme: the histories agree early on
+    imp = simulate(scene)
+    t = np.linspace(0.05, 0.3, 6)
+    for k in ("belt_speed", "driven_speed"):
+        a = np.interp(t, r.history["t"], r.history[k])
+        b = np.interp(t, imp.history["t"], imp.history[k])
+        assert np.max(np.abs(a - b)) < 3e-3 * ref.summary[k], k
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize("override, key", [
+    (("physics.inertia", False), "numerics.integrator"),
+    (("numerics.friction_law", "tanh"), "numerics.friction_law"),
+])
+def test_explicit_scheme_refuses_what_it_cannot_step(override, key):
+    scene = flat(("numerics.integrator", "explicit"), override)
+    with pytest.raises(SceneError, match=key):
+        simulate(scene)

@@ -38,6 +38,8 @@ SUMMARY_KEYS = ("tight_tension", "slack_tension", "belt_speed", "driven_speed", 
 MIN_STEP_FRACTION = 1e-4
 #: BDF2's local error per step, relative to the unknowns' scales (discrete.scales)
 DEFAULT_TIME_TOL = 1e-4
+#: the explicit scheme checks its state every this fraction of a transit
+CHECK_INTERVAL = 0.02
 #: the first step, relative to numerics.dt (the largest step)
 FIRST_STEP_FRACTION = 1e-3
 #: steps in a row with a whole arc sliding and the driven pulley slowing: gross slip
@@ -427,10 +429,91 @@ def bdf_coefficients(h, h_prev):
     return (1.0 + 2.0 * r) / ((1.0 + r) * h), -(1.0 + r) / h, r * r / ((1.0 + r) * h)
 
 
+class _Monitor:
+    """What every time-stepping scheme does after a step: the history, the snapshots, and
+    the stops (lift-off, gross slip, steady state), and the result at the end."""
+
+    def __init__(self, scene, num, mesh, lay, P, prm, speed, load, progress,
+                 snapshot_interval):
+        self.scene, self.num, self.mesh, self.lay, self.P, self.prm = (scene, num, mesh, lay,
+                                                                        P, prm)
+        self.speed, self.load = speed, load
+        self.progress, self.snapshot_interval = progress, snapshot_interval
+        self.settle = max(num.ramp_time, _last_table_time(scene))
+        self.hist = {k: [] for k in ("t", "omega1", "load_torque", *SUMMARY_KEYS,
+                                     *POWER_KEYS)}
+        self.snaps = {k: [] for k in SNAPSHOT_KEYS}
+        self.next_snap = 0.0
+        self.full_slip_steps = 0
+        self.start = time.perf_counter()
+
+    def check(self, t, y, ud, td, cdot, w2dot):
+        """Record the state after a step at t; (status, reason) when the run must stop."""
+        mesh, lay, P, num = self.mesh, self.lay, self.P, self.num
+        rim1, m2 = value(self.speed, t), value(self.load, t)
+        flds = fields_of(y, lay, mesh, P, self.prm, rim1, (ud, td))
+        on = mesh.lidx >= 0
+        if np.any(flds["pressure"][on] <= 0.0):
+            j = np.flatnonzero(on & (flds["pressure"] <= 0.0))[0]
+            return DriveStatus.LIFT_OFF, (
+                f"t = {t:.6g} s: the contact pressure fell to zero at x = {mesh.x[j]:.4g} m "
+                f"(the belt lifts off; this model does not describe lift-off)")
+        sm = summary_of(y, flds, lay, mesh, P, m2, rim1 / P.geometry.R1, rim1)
+        sm.update(power_terms(y, flds, cdot, lay, mesh, P, rim1, m2))
+        self.hist["t"].append(t)
+        self.hist["omega1"].append(rim1 / P.geometry.R1)
+        self.hist["load_torque"].append(m2)
+        for k in self.hist:
+            if k in sm:
+                self.hist[k].append(sm[k])
+        if self.progress is not None:
+            self.progress(t, num.t_end)
+        if self.snapshot_interval and t >= self.next_snap:
+            _snapshot(self.snaps, t, flds, sm)
+            self.next_snap = t + self.snapshot_interval
+        # gross slip: a whole arc slides while the driven pulley slows down (the load wins)
+        arcs_slide = [bool(np.all(flds["slip"][mesh.arc == a])) for a in (0, 1)]
+        self.full_slip_steps = self.full_slip_steps + 1 if any(arcs_slide) and w2dot < 0 \
+            else 0
+        if self.full_slip_steps >= GROSS_SLIP_STEPS:
+            which = "driver" if arcs_slide[0] else "driven pulley"
+            return DriveStatus.GROSS_SLIP, (
+                f"t = {t:.6g} s: the belt slides over the {which}'s whole wrap and the "
+                f"driven pulley slows down ({y[lay.omega2]:.6g} rad/s)")
+        if t < self.settle:
+            return None
+        rate = max(abs(cdot) / rim1, abs(w2dot) * P.geometry.R2 / rim1,
+                   float(np.max(np.abs(ud))) / (rim1 * P.N0 / P.b1))
+        if rate * transit_time(P) < num.steady_tol:
+            return DriveStatus.CONVERGED, None
+        return None
+
+    def result(self, status, reason, t, y, ud, td, cdot, statistics) -> DriveResult:
+        """The run's DriveResult from its last state."""
+        mesh, lay, P = self.mesh, self.lay, self.P
+        wall = time.perf_counter() - self.start
+        rim1, m2 = value(self.speed, t), value(self.load, t)
+        flds = fields_of(y, lay, mesh, P, self.prm, rim1, (ud, td))
+        final = summary_of(y, flds, lay, mesh, P, m2, rim1 / P.geometry.R1, rim1)
+        final.update(power_terms(y, flds, cdot, lay, mesh, P, rim1, m2))
+        if self.snapshot_interval and (not self.snaps["t"] or self.snaps["t"][-1] < t):
+            _snapshot(self.snaps, t, flds, final)
+        try:
+            ana = analytic_of(P)
+        except NoSolutionError:
+            ana = None
+        return DriveResult(self.scene, self.num, status, reason, mesh.x.copy(), flds, final,
+                           history={k: np.asarray(v) for k, v in self.hist.items()},
+                           analytic=ana,
+                           snapshots={k: np.asarray(v) for k, v in self.snaps.items()},
+                           wall_time=wall, statistics=statistics)
+
+
 def simulate(scene: DriveScene, elements: int | None = None, progress=None,
              snapshot_interval: float | None = None) -> DriveResult:
-    """Run the drive from rest (c = omega = 0, uniform N0) by BDF2 time steps until the
-    steady state, gross slip, lift-off or t_end.
+    """Run the drive from rest (c = omega = 0, uniform N0) until the steady state, gross
+    slip, lift-off or t_end: adaptive BDF2 steps (numerics.integrator = "implicit", the
+    default) or the explicit scheme ("explicit"); "steady" solves the steady state alone.
 
     Parameters
     ----------
@@ -448,29 +531,24 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
         return solve_steady(scene, elements)
     P, mesh, lay, prm, S = _setup(scene, num)
     speed, load = profiles(scene, num.ramp_time)
-    R1 = P.geometry.R1
-    settle = max(num.ramp_time, _last_table_time(scene))
+    mon = _Monitor(scene, num, mesh, lay, P, prm, speed, load, progress, snapshot_interval)
+    if num.integrator == "explicit":
+        return _run_explicit(mon, prm, speed, load)
     y = np.zeros(lay.size)
     nu = 2 * lay.N
-    v_prev = np.zeros(nu)  # rates of (u, theta) at the previous steps
+    v = v_prev = np.zeros(nu)  # rates of (u, theta) at the previous steps
     y_prev, y_prev2, v_prev2 = y.copy(), None, None
     past = [(0.0, y.copy())]  # the last accepted states, for the predictor
     h_prev = None
-    t = 0.0
+    t = cdot = 0.0
     dt = num.dt * FIRST_STEP_FRACTION
     stops = sorted(tt for tt in profile_stops(scene) if 0.0 < tt < num.t_end) + [num.t_end]
     yscale = S.yscale
     err_mask = np.ones(lay.size, bool)
     err_mask[2 * lay.N:2 * lay.N + lay.M] = False  # the friction ratios: no predictor
-    hist = {k: [] for k in ("t", "omega1", "load_torque", *SUMMARY_KEYS, *POWER_KEYS)}
     status, reason = DriveStatus.REACHED_END, None
     steps = its_total = rejected = 0
-    start = time.perf_counter()
-    strain = P.N0 / P.b1
-    full_slip_steps = 0
     just_rejected = False
-    snaps = {k: [] for k in SNAPSHOT_KEYS}
-    next_snap = 0.0
     while t < num.t_end - 1e-12 * num.t_end:
         stop = next(tt for tt in stops if tt > t * (1 + 1e-12))
         h = min(dt, stop - t)
@@ -525,64 +603,58 @@ def simulate(scene: DriveScene, elements: int | None = None, progress=None,
         y_prev2, v_prev2 = y_prev, v_prev
         y_prev, v_prev = y.copy(), v
         h_prev, t = h, t_new
-        flds = fields_of(y, lay, mesh, P, prm, rim1, (v[0::2], v[1::2]))
-        on = mesh.lidx >= 0
-        if np.any(flds["pressure"][on] <= 0.0):
-            j = np.flatnonzero(on & (flds["pressure"] <= 0.0))[0]
-            status, reason = DriveStatus.LIFT_OFF, (
-                f"t = {t:.6g} s: the contact pressure fell to zero at x = {mesh.x[j]:.4g} m "
-                f"(the belt lifts off; this model does not describe lift-off)")
-            break
         cdot = a0 * y[lay.c] + hc
-        sm = summary_of(y, flds, lay, mesh, P, m2, rim1 / R1, rim1)
-        sm.update(power_terms(y, flds, cdot, lay, mesh, P, rim1, m2))
-        hist["t"].append(t)
-        hist["omega1"].append(rim1 / R1)
-        hist["load_torque"].append(m2)
-        for k in hist:
-            if k in sm:
-                hist[k].append(sm[k])
-        if progress is not None:
-            progress(t, num.t_end)
-        if snapshot_interval and t >= next_snap:
-            _snapshot(snaps, t, flds, sm)
-            next_snap = t + snapshot_interval
-        # gross slip: a whole arc slides while the driven pulley slows down (the load wins)
-        arcs_slide = [bool(np.all(flds["slip"][mesh.arc == a])) for a in (0, 1)]
         w2dot = a0 * y[lay.omega2] + h2
-        full_slip_steps = full_slip_steps + 1 if any(arcs_slide) and w2dot < 0 else 0
-        if full_slip_steps >= GROSS_SLIP_STEPS:
-            which = "driver" if arcs_slide[0] else "driven pulley"
-            status, reason = DriveStatus.GROSS_SLIP, (
-                f"t = {t:.6g} s: the belt slides over the {which}'s whole wrap and the "
-                f"driven pulley slows down ({y[lay.omega2]:.6g} rad/s)")
+        stop = mon.check(t, y, v[0::2], v[1::2], cdot, w2dot)
+        if stop is not None:
+            status, reason = stop
             break
-        if t < settle:
-            continue
-        rate = max(abs(cdot) / rim1, abs(w2dot) * P.geometry.R2 / rim1,
-                   float(np.max(np.abs(v[0::2]))) / (rim1 * strain))
-        if rate * transit_time(P) < num.steady_tol:
-            status = DriveStatus.CONVERGED
+    return mon.result(status, reason, t, y, v[0::2], v[1::2], cdot,
+                      {"steps": steps, "newton_iterations": its_total,
+                       "rejected_steps": rejected})
+
+
+def _run_explicit(mon: _Monitor, prm, speed, load) -> DriveResult:
+    """The explicit scheme (beltdrive.explicit) from rest, checked every CHECK_INTERVAL of
+    a transit."""
+    from .explicit import advance, explicit_law_ok, stable_step
+
+    num, mesh, lay, P = mon.num, mon.mesh, mon.lay, mon.P
+    if not P.inertia:
+        raise SceneError("numerics.integrator", '"explicit" needs physics.inertia = true '
+                         "(a quasistatic belt has no waves to step)")
+    if not explicit_law_ok(prm.law):
+        raise SceneError("numerics.friction_law", '"explicit" takes the exact laws only '
+                         '(leave numerics.friction_law out, or "exact")')
+    N = lay.N
+    u, th, vu, vt, lam, F = (np.zeros(N) for _ in range(6))
+    state = np.zeros(3)  # c, omega2, c_t
+    rim_max = max(value(speed, tt) for tt in np.linspace(0.0, num.t_end, 2001))
+    dt = stable_step(mesh, P, rim_max)
+    chunk = max(1, int(round(CHECK_INTERVAL * transit_time(P) / dt)))
+    t = 0.0
+    steps = 0
+    status, reason = DriveStatus.REACHED_END, None
+    y = np.zeros(lay.size)
+    while t < num.t_end - 0.5 * dt:
+        n = min(chunk, max(1, int(round((num.t_end - t) / dt))))
+        w2_old = state[1]
+        t = advance(u, th, vu, vt, lam, F, state, t, dt, n, speed, load, mesh, prm,
+                    P.geometry.loop_length)
+        steps += n
+        if not np.all(np.isfinite(state)) or not np.all(np.isfinite(u)):
+            status, reason = DriveStatus.FAILED, f"t = {t:.6g} s: non-finite state"
             break
-    wall = time.perf_counter() - start
-    rim1 = value(speed, t)
-    m2 = value(load, t)
-    flds = fields_of(y, lay, mesh, P, prm, rim1,
-                     None if not steps else (v_prev[0::2], v_prev[1::2]))
-    final = summary_of(y, flds, lay, mesh, P, m2, rim1 / R1, rim1)
-    final.update(power_terms(y, flds, cdot if steps else 0.0, lay, mesh, P, rim1, m2))
-    if snapshot_interval and (not snaps["t"] or snaps["t"][-1] < t):
-        _snapshot(snaps, t, flds, final)
-    try:
-        ana = analytic_of(P)
-    except NoSolutionError:
-        ana = None
-    return DriveResult(scene, num, status, reason, mesh.x.copy(), flds, final,
-                       history={k: np.asarray(v) for k, v in hist.items()}, analytic=ana,
-                       snapshots={k: np.asarray(v) for k, v in snaps.items()},
-                       wall_time=wall,
-                       statistics={"steps": steps, "newton_iterations": its_total,
-                                   "rejected_steps": rejected})
+        y[0:2 * N:2], y[1:2 * N:2] = u, th
+        y[2 * N:2 * N + lay.M] = lam[mesh.lidx >= 0]
+        y[lay.c], y[lay.omega2] = state[0], state[1]
+        w2dot = (state[1] - w2_old) / (n * dt)
+        stop = mon.check(t, y, vu, vt, state[2], w2dot)
+        if stop is not None:
+            status, reason = stop
+            break
+    return mon.result(status, reason, t, y, vu, vt, state[2],
+                      {"steps": steps, "dt": dt})
 
 
 def drive_capacity(scene: DriveScene) -> float:

@@ -111,7 +111,7 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "model": _Rule("str", choices=("beam", "string")),
     },
     "numerics": {
-        "integrator": _Rule("str", choices=("implicit", "steady")),
+        "integrator": _Rule("str", choices=("implicit", "explicit", "steady")),
         "elements": _Rule("int", minimum=4 * MIN_SEGMENT_ELEMENTS),
         "dt": POS,
         "t_end": POS,
