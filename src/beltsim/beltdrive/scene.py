@@ -34,6 +34,7 @@ from ..problem.scene import (
     _Rule,
     _show,
     _toml_value,
+    check_table,
     final_value,
     parse_assignment,
 )
@@ -46,21 +47,7 @@ MIN_SEGMENT_ELEMENTS = 4
 def _check_load(key, value):
     """A load torque (N m): a number >= 0 (ramped from 0) or a table of [time, value] rows."""
     if isinstance(value, list):
-        rows = []
-        if not value:
-            raise SceneError(key, "a table needs at least one [time, value] row")
-        for i, row in enumerate(value, 1):
-            name = f"{key} row {i}"
-            if not isinstance(row, list) or len(row) != 2:
-                raise SceneError(name, f"must be a [time, value] pair, got {_show(row)}")
-            t, v = _number(f"{name} time", row[0]), _number(f"{name} value", row[1])
-            if rows and not t > rows[-1][0]:
-                raise SceneError(name, f"times must increase strictly, got {t!r} after "
-                                 f"{rows[-1][0]!r}")
-            if not v >= 0:
-                raise SceneError(f"{name} value", f"must be >= 0, got {v!r}")
-            rows.append([t, v])
-        return rows
+        return check_table(key, value, zero_allowed=True)
     value = _number(key, value)
     if not value >= 0:
         raise SceneError(key, f"must be >= 0, got {value!r}")

@@ -94,6 +94,27 @@ def _number(key, value):
     return float(value)
 
 
+def check_table(key, value: list, zero_allowed: bool = False) -> list:
+    """A table of [time, value] rows: times increasing strictly, values > 0 (>= 0 with
+    ``zero_allowed``), as a list of [float, float]."""
+    if not value:
+        raise SceneError(key, "a table needs at least one [time, value] row")
+    rows = []
+    for i, row in enumerate(value, 1):
+        name = f"{key} row {i}"
+        if not isinstance(row, list) or len(row) != 2:
+            raise SceneError(name, f"must be a [time, value] pair, got {_show(row)}")
+        t, v = _number(f"{name} time", row[0]), _number(f"{name} value", row[1])
+        if rows and not t > rows[-1][0]:
+            raise SceneError(name, f"times must increase strictly, got {t!r} after "
+                             f"{rows[-1][0]!r}")
+        if not (v >= 0 if zero_allowed else v > 0):
+            raise SceneError(f"{name} value", f"must be {'>=' if zero_allowed else '>'} 0, "
+                             f"got {v!r}")
+        rows.append([t, v])
+    return rows
+
+
 def _check_profile(key, value):
     """A positive quantity over time: a number, a table of [time, value] rows, or a sine.
 
@@ -117,21 +138,7 @@ def _check_profile(key, value):
                              f"{out['mean'] - abs(out['amplitude'])!r}")
         return out
     if isinstance(value, list):
-        if not value:
-            raise SceneError(key, "a table needs at least one [time, value] row")
-        rows = []
-        for i, row in enumerate(value, 1):
-            name = f"{key} row {i}"
-            if not isinstance(row, list) or len(row) != 2:
-                raise SceneError(name, f"must be a [time, value] pair, got {_show(row)}")
-            t, v = _number(f"{name} time", row[0]), _number(f"{name} value", row[1])
-            if rows and not t > rows[-1][0]:
-                raise SceneError(name, f"times must increase strictly, got {t!r} after "
-                                 f"{rows[-1][0]!r}")
-            if not v > 0:
-                raise SceneError(f"{name} value", f"must be > 0, got {v!r}")
-            rows.append([t, v])
-        return rows
+        return check_table(key, value)
     value = _number(key, value)
     if not value > 0:
         raise SceneError(key, f"must be > 0, got {value!r}")
