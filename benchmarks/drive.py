@@ -140,27 +140,44 @@ def start_up(scene, repeat: int, elements=None, log=print) -> dict:
 
 
 def steady(scene, repeat: int, elements=None, log=print) -> tuple[dict, object]:
-    """Our steady scheme, the shortest of ``repeat``."""
+    """Our steady scheme, the shortest of ``repeat``; a failure is recorded (``failed``:
+    its message; the result None), not raised."""
     from beltsim.beltdrive import solve_steady
+    from beltsim.beltdrive.discrete import layout_of, loop_mesh
+    from beltsim.errors import BeltsimError
 
     def once():
         t0 = time.perf_counter()
         res = solve_steady(scene, elements)
         return time.perf_counter() - t0, res
 
-    from beltsim.beltdrive.discrete import layout_of, loop_mesh
-
-    wall, res = _best(once, repeat)
-    n = layout_of(loop_mesh(scene.params.geometry, res.numerics.elements)).size
-    out = {"elements": res.numerics.elements, "nodes": len(res.x), "unknowns": n,
-           "wall_time": wall, "solve_wall_time": res.wall_time,
-           "newton_iterations": res.statistics["newton_iterations"],
-           "microseconds_per_unknown_iteration":
-               1e6 * res.wall_time / (n * max(res.statistics["newton_iterations"], 1)),
+    num_elements = elements or drive_numerics(scene).elements
+    n = layout_of(loop_mesh(scene.params.geometry, num_elements)).size
+    t0 = time.perf_counter()
+    try:
+        wall, res = _best(once, repeat)
+    except BeltsimError as exc:
+        wall = time.perf_counter() - t0
+        log(f"ours, steady ({num_elements} elements, {n} unknowns): FAILED after {wall:.3g} "
+            f"s: {exc}")
+        return {"elements": num_elements, "unknowns": n, "failed": str(exc),
+                "wall_time": None}, None
+    its = res.statistics["newton_iterations"]
+    out = {"elements": num_elements, "unknowns": n, "failed": None,
+           "wall_time": wall, "solve_wall_time": res.wall_time, "newton_iterations": its,
+           "microseconds_per_unknown_iteration": 1e6 * res.wall_time / (n * max(its, 1)),
            "summary": dict(res.summary), "errors": res.errors()}
-    log(f"ours, steady ({out['elements']} elements, {n} unknowns): wall {wall:.4g} s "
-        f"(solve {res.wall_time:.4g} s), {out['newton_iterations']} Newton iterations")
+    log(f"ours, steady ({num_elements} elements, {n} unknowns): wall {wall:.4g} s "
+        f"(solve {res.wall_time:.4g} s), {its} Newton iterations, "
+        f"{out['microseconds_per_unknown_iteration']:.3g} us per unknown and iteration")
     return out, res
+
+
+def drive_numerics(scene, elements=None):
+    """The scene's resolved numerics (:func:`beltsim.beltdrive.run.resolve`)."""
+    from beltsim.beltdrive.run import resolve
+
+    return resolve(scene, elements)
 
 
 def iteration_cost(scene, elements=None, log=print) -> dict:
@@ -338,6 +355,9 @@ def bench(scene, repeat: int = 3, elements=None, grids=GRID_FACTORS, peers=DEFAU
         fig, res = steady(scene, repeat, base * f, log)
         out["steady"].append(fig)
         if f == 1:
+            if res is None:
+                raise RuntimeError(f"the steady scheme failed on the scene's grid: "
+                                   f"{fig['failed']}")
             st0 = (fig, res)
         out["iteration"].append(iteration_cost(scene, base * f, log))
     su["difference"] = difference(su["summary"], st0[1].summary)

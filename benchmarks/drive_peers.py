@@ -220,7 +220,7 @@ def run_root_peer(scene, method: str = "hybr", elements=None, max_wall: float = 
     counts["scaled_residual"] = float(scaled)
     summary = run.summary_of(y, lay, mesh, P, prm, rim1, P.M2, P.omega1) \
         if np.all(np.isfinite(y)) else None
-    reason = "converged" if sol.success else f"not converged: {sol.message.strip()}"
+    reason = "converged" if sol.success else f"not converged: {' '.join(sol.message.split())}"
     return PeerResult(name, wall, bool(sol.success), reason, summary, counts)
 
 

@@ -5,9 +5,11 @@ scene and writes ``timings.md`` with its figure and ``index.md`` into DIR (defau
 ``docs/performance``): the default run and the steady scheme, the explicit kernel's
 node-steps per second and a cold start (:func:`beltsim.studies.bench.bench`); the
 generic scipy peers and the numpy port of the default scheme (:func:`benchmarks.bench.bench`);
-the compile time and the cache load time of the kernels, each in a fresh process; and the
-default run across grids. Every wall time is the shortest of ``--repeat`` runs with the
-kernels loaded, compilation apart. ``--quick`` does the same on a tiny grid, once.
+the compile time and the cache load time of the kernels, each in a fresh process; the
+default run across grids; and the closed drive against its generic peers
+(:mod:`benchmarks.drive`, in a fresh process). Every wall time is the shortest of
+``--repeat`` runs with the kernels loaded, compilation apart. ``--quick`` does the same
+on a tiny grid, once.
 
 Exit status: 0 when every beltsim run reached its steady state; 1 when one did not or a
 measurement failed (the page says which); 2 on a missing input or a bad option.
@@ -40,13 +42,17 @@ DEFAULT_OUT = ROOT / "docs" / "performance"
 SCENE = "paper_slip"
 #: (grid or None for the default, repeats, transient peers' wall cap in s, grid ladder)
 MODES = {False: (None, 3, 600.0, (250, 600, 1000, 2000)), True: (40, 1, 60.0, (20, 40, 60))}
+#: the closed drive's bench (benchmarks.drive), by mode: its options
+DRIVE_ARGS = {False: [], True: ["--elements", "40", "--repeat", "1", "--grids", "3",
+                                "--peers", "newton,lm,bdf2,radau", "--peer-cap", "60"]}
 TITLE = "Timings"
 INDEX_INTRO = (
     "How fast beltsim runs, measured by `python -m benchmarks.pages` on the machine its "
     "page names: the default run of the paper slip scene, the steady scheme, the explicit "
     "kernel, compilation and a cold start, against generic scipy peers and a numpy port "
-    "of the default scheme. `python -m benchmarks.pages --quick` does the same on a tiny "
-    "grid (CI runs it).")
+    "of the default scheme; and the closed belt drive's start-up and steady scheme against "
+    "generic peers on its discretisation. `python -m benchmarks.pages --quick` does the "
+    "same on tiny grids (CI runs it).")
 
 _KERNEL_LOAD = """
 import json, sys, time
@@ -211,8 +217,91 @@ def build(page: Page, quick: bool, cold: bool = True) -> None:
         page.para(f"The default run on {res['elements']} elements is timed {len(same)} times "
                   f"on this page, once by each command: {min(same):.3g} to {max(same):.3g} "
                   f"s. Their spread is the machine's, not beltsim's.")
+    _drive_section(page, quick)
     page.para(f"Load average at the end of the run: {os.getloadavg()[0]:.2f} (at the start: "
               f"see the top of the page); on this machine {os.cpu_count()} cores.")
+
+
+def run_drive_bench(args) -> dict:
+    """``python -m benchmarks.drive ARGS`` in a fresh process with one BLAS thread (as the
+    script runs itself, see its docstring): its dict."""
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "drive.json"
+        proc = subprocess.run([sys.executable, "-m", "benchmarks.drive", *args, "--json",
+                               str(out)], cwd=ROOT, env=env, capture_output=True, text=True,
+                              timeout=7200, check=False)
+        if proc.returncode != 0:
+            raise RuntimeError(f"benchmarks.drive failed: {proc.stderr.strip()[-500:]}")
+        for line in proc.stdout.splitlines()[:-1]:
+            log(line)
+        return json.loads(out.read_text(encoding="utf-8"))
+
+
+def _drive_section(page: Page, quick: bool) -> None:
+    args = DRIVE_ARGS[quick]
+    page.heading("The closed belt drive")
+    page.para(
+        f"`python -m benchmarks.drive {' '.join(args)}`".replace(" `", "`") + ": the shipped "
+        "`drive_flat` scene from rest to steady state (`beltsim.beltdrive.simulate`, exact "
+        "Coulomb friction) and its steady scheme (`solve_steady`), on the scene's grid and "
+        "on finer ones, against generic peers that solve the same discrete equations (the "
+        "numpy/scipy.sparse reference of the kernel) with generic tools. Every wall time is "
+        "of the whole call, the shortest of the repeats, with one BLAS thread; compiling "
+        "and loading the kernels are timed apart in fresh processes.")
+    d = run_drive_bench(args)
+    su = d["start_up"]
+    if not su["converged"]:
+        page.fail(f"the drive's default run: {su['status']} ({su['reason']})")
+    k = d.get("kernels") or {}
+    rows = [["compile the drive's kernels, empty cache [s]", fmt(k.get("compile_s"), ".3g")],
+            ["load them from numba's cache [s]", fmt(k.get("load_s"), ".3g")],
+            [f"start-up, {su['elements']} elements: wall to steady state [s]",
+             fmt(su["wall_time"], ".4g")],
+            ["start-up: steps, Newton iterations", f"{su['steps']}, {su['newton_iterations']}"],
+            ["start-up: simulated time [s]", fmt(su["simulated_time"], ".4g")],
+            ["start-up: largest relative difference from the steady state",
+             fmt(su.get("difference"), ".2e")]]
+    page.table(["quantity", "value"], rows)
+    steady_rows = []
+    for st, it in zip(d["steady"], d["iteration"]):
+        if st.get("failed"):
+            page.fail(f"steady scheme, {st['elements']} elements: {st['failed']}")
+        steady_rows.append([
+            str(st["elements"]), str(st["unknowns"]),
+            fmt(st["wall_time"], ".4g") if not st.get("failed") else f"failed: {st['failed']}",
+            str(st.get("newton_iterations", "")),
+            fmt(st.get("microseconds_per_unknown_iteration"), ".3g"),
+            fmt(1e3 * it["residual_jacobian_s"], ".3g"), fmt(1e3 * it["linear_solve_s"], ".3g")])
+    page.table(["elements", "unknowns", "steady scheme, wall [s]", "Newton iterations",
+                "solve per unknown and iteration [us]", "residual + Jacobian [ms]",
+                "bordered-band linear solve [ms]"], steady_rows)
+    peer_rows = []
+    for key, e in d["peers"].items():
+        if key == "ours_tanh":
+            continue
+        ratio = (fmt(e["ratio"], ".3g") if e.get("ratio") is not None else
+                 (f">= {fmt(e['ratio_at_least'], '.3g')}" if e.get("ratio_at_least")
+                  else ""))
+        peer_rows.append([e["method"], fmt(e["wall_time"], ".4g"),
+                          "yes" if e["converged"] else f"no: {e['reason']}",
+                          fmt(e.get("difference"), ".1e"), e.get("ours", ""), ratio])
+    page.table(["peer", "wall [s]", "reached our steady state", "largest relative difference",
+                "against ours", "its wall over ours"], peer_rows)
+    tanh = d["peers"].get("ours_tanh")
+    if tanh:
+        page.para(f"The solve_ivp peers need a single-valued friction law: they run the tanh "
+                  f"law (v_reg a tenth of the creep speed) and are timed against our run of "
+                  f"that law ({fmt(tanh['wall_time'], '.3g')} s, {tanh['steps']} steps). "
+                  f"Every peer is compared with our steady state of its law.")
+    sp = d["speedup"]
+    page.para(f"Speed-up, the fastest converged peer's wall over ours: steady "
+              f"{fmt(sp['steady'], '.3g')}x, start-up {fmt(sp['start_up'], '.3g')}x; against "
+              f"our own algorithms on generic pieces (what the compiled kernels and the "
+              f"bordered-band solve buy): steady {fmt(d['kernel_speedup']['steady'], '.3g')}x, "
+              f"start-up {fmt(d['kernel_speedup']['start_up'], '.3g')}x; against generic "
+              f"solvers: steady {fmt(d['solver_speedup']['steady'], '.3g')}x, start-up "
+              f"{fmt(d['solver_speedup']['start_up'], '.3g')}x.")
 
 
 def main(argv=None) -> int:
