@@ -183,8 +183,9 @@ def drive_numerics(scene, elements=None):
 def iteration_cost(scene, elements=None, log=print) -> dict:
     """One Newton iteration's pieces at the string's state (the steady Newton's start):
     the residual alone, the residual with the Jacobian's triplets (numba), and the
-    bordered-band solve (scatter, LAPACK gbsv, the border's Schur complement); each the
-    shortest of enough calls to last about 0.2 s."""
+    bordered-band solve (scatter, LAPACK gbsv, the border's Schur complement); and the
+    start itself (the string's solution and its values on the grid). Each the shortest
+    of enough calls to last about 0.2 s."""
     from beltsim.beltdrive.analytic import solve_string
     from beltsim.beltdrive.discrete import layout_of, loop_mesh, loop_params, string_guess
     from beltsim.beltdrive.model import assemble
@@ -223,13 +224,15 @@ def iteration_cost(scene, elements=None, log=print) -> dict:
            "residual_s": timed(lambda: assemble(y, rates, rim1, P.M2, mesh, prm, S.R, S.rows,
                                                 S.cols, S.vals, False)),
            "residual_jacobian_s": timed(jac),
-           "linear_solve_s": timed(lambda: S.band.solve(S, n, R))}
+           "linear_solve_s": timed(lambda: S.band.solve(S, n, R)),
+           "start_s": timed(lambda: string_guess(solve_string(P), mesh, lay))}
     out["linear_solve_us_per_unknown"] = 1e6 * out["linear_solve_s"] / lay.size
     log(f"ours, one Newton iteration ({num.elements} elements, {lay.size} unknowns): "
         f"residual {1e3 * out['residual_s']:.3g} ms, with Jacobian "
         f"{1e3 * out['residual_jacobian_s']:.3g} ms, linear solve "
         f"{1e3 * out['linear_solve_s']:.3g} ms "
-        f"({out['linear_solve_us_per_unknown']:.3g} us per unknown)")
+        f"({out['linear_solve_us_per_unknown']:.3g} us per unknown); the steady Newton's "
+        f"start (the string's state on the grid) {1e3 * out['start_s']:.3g} ms")
     return out
 
 

@@ -217,7 +217,7 @@ def build(page: Page, quick: bool, cold: bool = True) -> None:
         page.para(f"The default run on {res['elements']} elements is timed {len(same)} times "
                   f"on this page, once by each command: {min(same):.3g} to {max(same):.3g} "
                   f"s. Their spread is the machine's, not beltsim's.")
-    _drive_section(page, quick)
+    _drive_section(page, quick, cold)
     page.para(f"Load average at the end of the run: {os.getloadavg()[0]:.2f} (at the start: "
               f"see the top of the page); on this machine {os.cpu_count()} cores.")
 
@@ -238,8 +238,8 @@ def run_drive_bench(args) -> dict:
         return json.loads(out.read_text(encoding="utf-8"))
 
 
-def _drive_section(page: Page, quick: bool) -> None:
-    args = DRIVE_ARGS[quick]
+def _drive_section(page: Page, quick: bool, cold: bool) -> None:
+    args = DRIVE_ARGS[quick] + ([] if cold else ["--no-kernels"])
     page.heading("The closed belt drive")
     page.para(
         f"`python -m benchmarks.drive {' '.join(args)}`".replace(" `", "`") + ": the shipped "
@@ -254,8 +254,9 @@ def _drive_section(page: Page, quick: bool) -> None:
     if not su["converged"]:
         page.fail(f"the drive's default run: {su['status']} ({su['reason']})")
     k = d.get("kernels") or {}
-    rows = [["compile the drive's kernels, empty cache [s]", fmt(k.get("compile_s"), ".3g")],
-            ["load them from numba's cache [s]", fmt(k.get("load_s"), ".3g")],
+    rows = [["compile the drive's kernels, empty cache [s]",
+             fmt(k.get("compile_s"), ".3g") or "not measured"],
+            ["load them from numba's cache [s]", fmt(k.get("load_s"), ".3g") or "not measured"],
             [f"start-up, {su['elements']} elements: wall to steady state [s]",
              fmt(su["wall_time"], ".4g")],
             ["start-up: steps, Newton iterations", f"{su['steps']}, {su['newton_iterations']}"],
@@ -272,10 +273,11 @@ def _drive_section(page: Page, quick: bool) -> None:
             fmt(st["wall_time"], ".4g") if not st.get("failed") else f"failed: {st['failed']}",
             str(st.get("newton_iterations", "")),
             fmt(st.get("microseconds_per_unknown_iteration"), ".3g"),
-            fmt(1e3 * it["residual_jacobian_s"], ".3g"), fmt(1e3 * it["linear_solve_s"], ".3g")])
+            fmt(1e3 * it["residual_jacobian_s"], ".3g"), fmt(1e3 * it["linear_solve_s"], ".3g"),
+            fmt(1e3 * it["start_s"], ".3g")])
     page.table(["elements", "unknowns", "steady scheme, wall [s]", "Newton iterations",
                 "solve per unknown and iteration [us]", "residual + Jacobian [ms]",
-                "bordered-band linear solve [ms]"], steady_rows)
+                "bordered-band linear solve [ms]", "the string's start [ms]"], steady_rows)
     peer_rows = []
     for key, e in d["peers"].items():
         if key == "ours_tanh":
