@@ -12,13 +12,17 @@ start.
   semi-smooth Newton, the same BDF2 steps and step control, the same steady test; only
   the pieces are generic (:func:`run_generic_transient`, :func:`run_generic_steady`).
 * :func:`run_root_peer`: ``scipy.optimize.root`` on the scaled steady residual from the
-  same start (the string's analytic state): "hybr" (MINPACK's Powell hybrid with the
-  reference Jacobian, densified) or "krylov" (Newton-Krylov, Jacobian-free).
+  same start (the string's analytic state): "hybr" (MINPACK's Powell hybrid) and "lm"
+  (MINPACK's Levenberg-Marquardt) with the reference Jacobian, densified, or "krylov"
+  (Newton-Krylov, Jacobian-free).
 * :class:`DriveODE` and :func:`run_ode_peer`: ``scipy.integrate``'s BDF or Radau from rest
   on the method-of-lines ODE of the same semi-discretisation, which exists for a
   regularised law only: the friction ratios are then explicit, lam = g(v_rel / v_reg), and
   the gauge (mean of u = 0) is kept by taking c_t from the loop's momentum balance, so
-  that the accelerations satisfy the gauge's second derivative.
+  that the accelerations satisfy the gauge's second derivative. Its Jacobian
+  (:func:`ode_jacobian`, from the reference Jacobian) is dense: c_t, a sum over the
+  contact nodes, enters every axial acceleration, a rank-one coupling that scipy's
+  integrators cannot keep apart from the sparse rest (our Newton keeps c in a border).
 
 Wall times are of the whole call (building the peer's system included, as for ours).
 """
