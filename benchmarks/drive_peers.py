@@ -122,6 +122,10 @@ def generic_pieces(linear: str = "splu"):
 
 
 def _counts(built) -> dict:
+    if not built or not any(s.counts["jacobians"] for s in built):
+        # a run that built its system elsewhere would time our kernels as the peer's
+        raise RuntimeError("the drive's run did not use the generic pieces (it no longer "
+                           "builds its system through beltsim.beltdrive.run.make_system)")
     return {"residual_evaluations": sum(s.counts["residuals"] for s in built),
             "jacobian_evaluations": sum(s.counts["jacobians"] for s in built),
             "linear_solve_time": sum(s.linear_time for s in built)}
