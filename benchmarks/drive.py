@@ -216,12 +216,13 @@ def iteration_cost(scene, elements=None, log=print) -> dict:
         return best
 
     def jac():
-        return assemble(y, rates, rim1, P.M2, mesh, prm, S.R, S.rows, S.cols, S.vals, True)
+        return assemble(y, rates, rim1, P.M2, S.q, mesh, prm, S.R, S.rows, S.cols, S.vals,
+                        True)
 
     n = jac()
     R = S.R.copy()
     out = {"elements": num.elements, "unknowns": lay.size,
-           "residual_s": timed(lambda: assemble(y, rates, rim1, P.M2, mesh, prm, S.R, S.rows,
+           "residual_s": timed(lambda: assemble(y, rates, rim1, P.M2, S.q, mesh, prm, S.R, S.rows,
                                                 S.cols, S.vals, False)),
            "residual_jacobian_s": timed(jac),
            "linear_solve_s": timed(lambda: S.band.solve(S, n, R)),

@@ -226,8 +226,10 @@ def run_root_peer(scene, method: str = "hybr", elements=None, max_wall: float = 
     y = sol.x
     scaled = np.abs(reference.residual(y, rates, rim1, P.M2, mesh, prm) / rs).max()
     counts["scaled_residual"] = float(scaled)
-    summary = run.summary_of(y, lay, mesh, P, prm, rim1, P.M2, P.omega1) \
-        if np.all(np.isfinite(y)) else None
+    summary = None
+    if np.all(np.isfinite(y)):
+        flds = run.fields_of(y, lay, mesh, P, prm, rim1)
+        summary = run.summary_of(y, flds, lay, mesh, P, P.M2, P.omega1, rim1)
     reason = "converged" if sol.success else f"not converged: {' '.join(sol.message.split())}"
     return PeerResult(name, wall, bool(sol.success), reason, summary, counts)
 
@@ -306,8 +308,10 @@ class DriveODE:
         s = reference.slip_velocity(y, rates, rim1, self.mesh, self.prm) / self.prm.v_scale
         y = y.copy()
         y[2 * self.N:2 * self.N + self.lay.M] = law_numpy(self.prm.law, s)[0]
-        return run.summary_of(y, self.lay, self.mesh, self.P, self.prm, rim1, load,
-                              rim1 / self.P.geometry.R1)
+        flds = run.fields_of(y, self.lay, self.mesh, self.P, self.prm, rim1,
+                             (rates.hu, rates.ht))
+        return run.summary_of(y, flds, self.lay, self.mesh, self.P, load,
+                              rim1 / self.P.geometry.R1, rim1)
 
 
 def _rates_at(a0, z, ode):
