@@ -18,11 +18,16 @@ reference of the kernel) with generic tools: the steady state by the same Newton
 scipy.sparse (``spsolve``) and by ``scipy.optimize.root`` ("hybr", "krylov"); the start-up
 by the same BDF2 steps on scipy.sparse (``splu``), and by ``solve_ivp``'s Radau and BDF
 on the method-of-lines ODE, which exists for a regularised law only (tanh, the drive's
-default v_reg) and is compared with our run of that law. Each peer's wall time over ours
-is its ratio; a peer counts when it converged and its summary is within SAME_STATE of the
-reference state (see :func:`bench`). Every wall time is of the whole call, the shortest
-of ``--repeat`` runs with the kernels loaded (a peer that needs more than
-PEER_REPEAT_LIMIT seconds runs once); the wall-time cap ``--peer-cap`` stops a peer.
+default v_reg) and is compared with our run of that law. A peer counts when it converged
+and its summary is within SAME_STATE of our steady state (see :func:`bench`).
+
+Two wall times: the whole call, and the solve, which is what the ratios compare: a run's
+own ``wall_time`` (from its start to its last state: without the grid's setup and the
+analytic solution every result carries, ~20 ms for the beam's), for ours and for the
+peers that run our algorithms; the whole call for the scipy peers, whose setup is a few
+array operations. Each is the shortest of ``--repeat`` runs with the kernels loaded (a
+peer that needs more than PEER_REPEAT_LIMIT seconds runs once); ``--peer-cap`` stops a
+peer.
 
 Run as a script, the module keeps BLAS to one thread (``OPENBLAS_NUM_THREADS=1`` unless
 set): on this 2-core machine, shared, OpenBLAS's threads made a dense LU of 400 unknowns
@@ -72,11 +77,6 @@ def _plain(v):
     return v
 
 
-def _best(fn, repeat: int, wall=lambda r: r[0]):
-    """The shortest of ``repeat`` calls of fn() (each returns (wall, ...))."""
-    return min((fn() for _ in range(repeat)), key=wall)
-
-
 _KERNEL_LOAD = """
 import json, sys, time
 from beltsim.beltdrive import DriveScene, simulate, solve_steady
@@ -116,14 +116,10 @@ def start_up(scene, repeat: int, elements=None, log=print) -> dict:
         res = simulate(scene, elements)
         return time.perf_counter() - t0, res
 
-    walls = []
-    best = None
-    for _ in range(repeat):
-        w, res = once()
-        walls.append(w)
-        if best is None or w < best[0]:
-            best = (w, res)
-    wall, res = best
+    runs = [once() for _ in range(repeat)]
+    walls = [w for w, _ in runs]
+    wall = min(walls)
+    res = min((r for _, r in runs), key=lambda r: r.wall_time)
     st = res.statistics
     out = {"wall_time": wall, "walls": walls, "solve_wall_time": res.wall_time,
            "status": res.status.value, "reason": res.reason, "converged": res.converged,
@@ -135,7 +131,7 @@ def start_up(scene, repeat: int, elements=None, log=print) -> dict:
     log(f"ours, start-up ({out['friction_law']} law, {out['elements']} elements): "
         f"{res.status.value} at t = {out['simulated_time']:.4g} s, {out['steps']} steps, "
         f"{out['newton_iterations']} Newton iterations, wall {wall:.4g} s (shortest of "
-        f"{repeat}: {', '.join(f'{w:.3g}' for w in walls)})")
+        f"{repeat}: {', '.join(f'{w:.3g}' for w in walls)}), solve {res.wall_time:.4g} s")
     return out, res
 
 
@@ -155,13 +151,15 @@ def steady(scene, repeat: int, elements=None, log=print) -> tuple[dict, object]:
     n = layout_of(loop_mesh(scene.params.geometry, num_elements)).size
     t0 = time.perf_counter()
     try:
-        wall, res = _best(once, repeat)
+        runs = [once() for _ in range(repeat)]
     except BeltsimError as exc:
         wall = time.perf_counter() - t0
         log(f"ours, steady ({num_elements} elements, {n} unknowns): FAILED after {wall:.3g} "
             f"s: {exc}")
         return {"elements": num_elements, "unknowns": n, "failed": str(exc),
                 "wall_time": None}, None
+    wall = min(w for w, _ in runs)
+    res = min((r for _, r in runs), key=lambda r: r.wall_time)
     its = res.statistics["newton_iterations"]
     out = {"elements": num_elements, "unknowns": n, "failed": None,
            "wall_time": wall, "solve_wall_time": res.wall_time, "newton_iterations": its,
@@ -238,6 +236,7 @@ def iteration_cost(scene, elements=None, log=print) -> dict:
 
 
 def _peer_entry(res, reference: dict, ours_wall: float, ours_label: str) -> dict:
+    """A peer's row: ``ours_wall`` is our solve's wall time, compared with the peer's."""
     from .drive_peers import SAME_STATE, difference, speed_loss_difference
 
     diff = difference(res.summary, reference)
@@ -245,20 +244,23 @@ def _peer_entry(res, reference: dict, ours_wall: float, ours_label: str) -> dict
     converged = bool(res.converged and same)
     reason = res.reason if same or not res.converged else \
         f"converged, but {diff:.2g} from the reference state"
-    return {"method": res.name, "wall_time": res.wall_time, "converged": converged,
+    solve = res.solve_wall_time if res.solve_wall_time is not None else res.wall_time
+    return {"method": res.name, "wall_time": res.wall_time, "solve_wall_time": solve,
+            "converged": converged,
             "reason": reason, "difference": diff,
             "speed_loss_difference": speed_loss_difference(res.summary, reference),
             "statistics": res.statistics,
-            "ours": ours_label, "ours_wall_time": ours_wall,
-            "ratio": res.wall_time / ours_wall if converged else None,
-            "ratio_at_least": res.wall_time / ours_wall}
+            "ours": ours_label, "ours_solve_wall_time": ours_wall,
+            "ratio": solve / ours_wall if converged else None,
+            "ratio_at_least": solve / ours_wall}
 
 
 def _run_peer(fn, repeat: int):
     first = fn()
     if not first.converged or first.wall_time > PEER_REPEAT_LIMIT:
         return first
-    return min([first] + [fn() for _ in range(repeat - 1)], key=lambda r: r.wall_time)
+    return min([first] + [fn() for _ in range(repeat - 1)],
+               key=lambda r: r.solve_wall_time or r.wall_time)
 
 
 def run_peers(scene, which, repeat: int, peer_cap: float, ours: dict, elements=None,
@@ -290,7 +292,7 @@ def run_peers(scene, which, repeat: int, peer_cap: float, ours: dict, elements=N
         base = st_fig if PEERS[key] == "steady" else su_fig
         label = "steady scheme" if PEERS[key] == "steady" else \
             f"default run ({su_fig['friction_law']} law)"
-        out[key] = entry = _peer_entry(res, st_res.summary, base["wall_time"], label)
+        out[key] = entry = _peer_entry(res, st_res.summary, base["solve_wall_time"], label)
         _log_peer(key, entry, log)
     odes = [k for k in which if k in ("radau", "bdf")]
     if odes:
@@ -299,7 +301,8 @@ def run_peers(scene, which, repeat: int, peer_cap: float, ours: dict, elements=N
         fig, _ = start_up(tanh, repeat, elements, log)
         fig["difference"] = dp.difference(fig["summary"], ref)
         fig["speed_loss_difference"] = dp.speed_loss_difference(fig["summary"], ref)
-        out["ours_tanh"] = {k: fig[k] for k in ("wall_time", "steps", "newton_iterations",
+        out["ours_tanh"] = {k: fig[k] for k in ("wall_time", "solve_wall_time", "steps",
+                                                  "newton_iterations",
                                                   "simulated_time", "converged",
                                                   "difference", "speed_loss_difference")}
         for key in odes:
@@ -312,7 +315,7 @@ def run_peers(scene, which, repeat: int, peer_cap: float, ours: dict, elements=N
                             "converged": False, "reason": f"not applicable: {exc}",
                             "ratio": None, "ratio_at_least": None}
                 continue
-            out[key] = entry = _peer_entry(res, ref, fig["wall_time"],
+            out[key] = entry = _peer_entry(res, ref, fig["solve_wall_time"],
                                            "default run, tanh law")
             _log_peer(key, entry, log)
     return out
@@ -322,8 +325,9 @@ def _log_peer(key, e, log):
     diff = "n/a" if e["difference"] is None else f"{e['difference']:.2g}"
     ratio = (f"{e['ratio']:.3g}x" if e["ratio"] is not None else
              f"not converged (>= {e['ratio_at_least']:.3g}x)")
-    log(f"peer {key:6s} ({e['method']}): wall {e['wall_time']:.4g} s, {e['reason']}; "
-        f"{diff} from our steady state; its wall over ours ({e['ours']}): {ratio}")
+    log(f"peer {key:6s} ({e['method']}): wall {e['wall_time']:.4g} s (solve "
+        f"{e['solve_wall_time']:.4g} s), {e['reason']}; {diff} from our steady state; its "
+        f"solve's wall over ours ({e['ours']}): {ratio}")
 
 
 def bench(scene, repeat: int = 3, elements=None, grids=GRID_FACTORS, peers=DEFAULT_PEERS,
@@ -378,7 +382,7 @@ def bench(scene, repeat: int = 3, elements=None, grids=GRID_FACTORS, peers=DEFAU
             ratios = [e["ratio"] for k, e in out["peers"].items()
                       if PEERS.get(k) == kind and keep(k) and e.get("ratio") is not None]
             out[name][kind] = min(ratios) if ratios else None
-        log(f"{name} (the fastest converged peer's wall over ours"
+        log(f"{name} (the fastest converged peer's solve wall over ours"
             f"{'' if name == 'speedup' else ', ' + name.split('_')[0] + ' peers'}): steady "
             f"{_ratio(out[name]['steady'])}, start-up {_ratio(out[name]['start_up'])}")
     out["load_average_end"] = os.getloadavg()[0]
