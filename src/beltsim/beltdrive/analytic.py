@@ -169,19 +169,35 @@ class StringSolution:
         x = np.mod(np.asarray(x, dtype=float), lam)
         return self._antiderivative(x) - mean
 
+    def _pieces(self):
+        """The tension as pieces (a, b, const, amp, rate): N = const + amp exp(rate (x - a))
+        on [a, b] (rate 0: constant)."""
+        g = self.P.geometry
+        e = g.bounds
+        rc = self.centrifugal
+        if self.P.mu is None:
+            s1, s2 = e[1], e[3]
+        else:
+            s1, s2 = self.stick_ends
+        k = 0.0 if self.P.mu is None else self.P.mu / self.kappa
+        return [(e[0], s1, self.T1, 0.0, 0.0),
+                (s1, e[1], rc, self.T1 - rc, -k / g.R1),
+                (e[1], s2, self.T2, 0.0, 0.0),
+                (s2, e[3], rc, self.T2 - rc, k / g.R2),
+                (e[3], e[4], self.T1, 0.0, 0.0)]
+
     def _antiderivative(self, x) -> np.ndarray:
-        """The integral of (N - N0) / b1 from 0 to x (each piece's exact integral, by
-        Gauss-Legendre on the piece's part below x: N is smooth within a piece)."""
-        br = self._breakpoints()
-        xg, wg = _GAUSS
-        flat = np.ravel(x)
+        """The integral of (N - N0) / b1 from 0 to x, piece by piece in closed form."""
+        flat = np.ravel(np.asarray(x, dtype=float))
         out = np.zeros_like(flat)
-        for a, b in zip(br[:-1], br[1:]):
-            hi = np.clip(flat, a, b)
-            # nodes on [a, hi] for every x at once: (points, 24)
-            pts = a + (hi - a)[:, None] * 0.5 * (xg[None, :] + 1.0)
-            vals = self.tension(pts.ravel()).reshape(pts.shape) - self.P.N0
-            out += 0.5 * (hi - a) * (vals @ wg)
+        for a, b, const, amp, rate in self._pieces():
+            hi = np.clip(flat, a, b) - a
+            part = (const - self.P.N0) * hi
+            if amp != 0.0 and rate != 0.0:
+                part = part + amp * np.expm1(rate * hi) / rate
+            elif amp != 0.0:
+                part = part + amp * hi
+            out += part
         return out.reshape(np.shape(x)) / self.P.b1
 
     def _breakpoints(self) -> np.ndarray:

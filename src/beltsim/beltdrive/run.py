@@ -283,10 +283,24 @@ class DriveResult:
     fields: dict
     summary: dict
     history: dict = field(default_factory=dict)
-    analytic: object | None = None
     wall_time: float = 0.0
     statistics: dict = field(default_factory=dict)
     snapshots: dict = field(default_factory=dict)
+    _analytic: object = field(default=None, repr=False, compare=False)
+    _analytic_done: bool = field(default=False, repr=False, compare=False)
+
+    @property
+    def analytic(self):
+        """The analytic steady state the run compares with (:func:`analytic_of`; None where
+        the drive has none, e.g. beyond its capacity). Solved on first use: the beam's takes
+        about as long as the discrete steady solve."""
+        if not self._analytic_done:
+            try:
+                self._analytic = analytic_of(self.scene.params)
+            except NoSolutionError:
+                self._analytic = None
+            self._analytic_done = True
+        return self._analytic
 
     @property
     def converged(self) -> bool:
@@ -339,8 +353,69 @@ def _setup(scene, num):
     return P, mesh, lay, prm, make_system(mesh, prm, lay, P)
 
 
+#: the steady solve starts a grid finer than this many times the default from the steady
+#: state of a grid COARSENING times coarser (recursively)
+FINE_GRID_FACTOR = 4
+COARSENING = 4
+
+
+def _steady_y(scene: DriveScene, num: DriveNumerics, elements: int):
+    """(y, mesh, lay, prm, Newton iterations) of the discrete steady state on ``elements``.
+
+    The semi-smooth Newton moves a slip front by about one node an iteration, so on a
+    fine grid the string's front (the beam's differs by millimetres) is many iterations
+    away: there the start is the steady state of a grid four times coarser, interpolated.
+    """
+    P = scene.params
+    mesh = loop_mesh(P.geometry, elements)
+    lay = layout_of(mesh)
+    prm = loop_params(P, num.friction_law, num.regularisation)
+    S = make_system(mesh, prm, lay, P)
+    rim1 = P.omega1 * P.geometry.R1
+    its = 0
+    if elements > FINE_GRID_FACTOR * DEFAULT_ELEMENTS:
+        yc, meshc, layc, _, its = _steady_y(scene, num, elements // COARSENING)
+        y = _interpolated(yc, meshc, layc, mesh, lay, P.geometry.loop_length)
+    else:
+        y = string_guess(solve_string(P), mesh, lay)
+        if num.regularisation is not None:
+            # a regularised law from the creep scale down to its own v_reg, ten by ten:
+            # from the exact law's start a sharp regularisation's Newton does not converge
+            v = creep_speed(P)
+            while v > 10.0 * prm.v_scale:
+                S.params = prm._replace(v_scale=v)
+                its += newton(S, y, steady_rates(lay.N), rim1, P.M2, num.newton_tol,
+                              num.newton_max_iterations)
+                v /= 10.0
+            S.params = prm
+    its += newton(S, y, steady_rates(lay.N), rim1, P.M2, num.newton_tol,
+                  num.newton_max_iterations)
+    return y, mesh, lay, prm, its
+
+
+def _interpolated(yc, meshc, layc, mesh, lay, loop_length):
+    """A coarse grid's unknowns on a finer grid: fields and friction ratios linear in x
+    (periodic), the ratios kept within [-1, 1]; c and omega2 as they are."""
+    xc = np.append(meshc.x, loop_length)
+
+    def onto(values):
+        return np.interp(mesh.x, xc, np.append(values, values[0]))
+
+    y = np.zeros(lay.size)
+    y[0:2 * lay.N:2] = onto(layc.u(yc))
+    y[1:2 * lay.N:2] = onto(layc.theta(yc))
+    ratio = np.zeros(layc.N)
+    on = meshc.lidx >= 0
+    ratio[on] = layc.lam(yc)[meshc.lidx[on]]
+    fine = mesh.lidx >= 0
+    lay.lam(y)[mesh.lidx[fine]] = np.clip(onto(ratio)[fine], -1.0, 1.0)
+    y[lay.c], y[lay.omega2] = yc[layc.c], yc[layc.omega2]
+    return y
+
+
 def solve_steady(scene: DriveScene, elements: int | None = None) -> DriveResult:
-    """The discrete steady state, by Newton from the string's analytic state.
+    """The discrete steady state, by Newton from the string's analytic state (on fine
+    grids from a coarser grid's steady state).
 
     Raises
     ------
@@ -349,32 +424,16 @@ def solve_steady(scene: DriveScene, elements: int | None = None) -> DriveResult:
         lifts off).
     """
     num = resolve(scene, elements)
-    P, mesh, lay, prm, S = _setup(scene, num)
+    P = scene.params
     start = time.perf_counter()
-    sol = solve_string(P)
-    y = string_guess(sol, mesh, lay)
-    rim1 = P.omega1 * P.geometry.R1
-    its = 0
-    if num.regularisation is not None:
-        # a regularised law from the creep scale down to its own v_reg, ten by ten: from
-        # the exact law's start a sharp regularisation's Newton does not converge
-        target = prm.v_scale
-        v = creep_speed(P)
-        while v > 10.0 * target:
-            S.params = prm._replace(v_scale=v)
-            its += newton(S, y, steady_rates(lay.N), rim1, P.M2, num.newton_tol,
-                          num.newton_max_iterations)
-            v /= 10.0
-        S.params = prm
-    its += newton(S, y, steady_rates(lay.N), rim1, P.M2, num.newton_tol,
-                  num.newton_max_iterations)
+    y, mesh, lay, prm, its = _steady_y(scene, num, num.elements)
     wall = time.perf_counter() - start
+    rim1 = P.omega1 * P.geometry.R1
     flds = fields_of(y, lay, mesh, P, prm, rim1)
     final = summary_of(y, flds, lay, mesh, P, P.M2, P.omega1, rim1)
     final.update(power_terms(y, flds, 0.0, lay, mesh, P, rim1, P.M2))
     return DriveResult(scene, num, DriveStatus.CONVERGED, None, mesh.x.copy(), flds, final,
-                       analytic=analytic_of(P), wall_time=wall,
-                       statistics={"newton_iterations": its})
+                       wall_time=wall, statistics={"newton_iterations": its})
 
 
 #: what a snapshot holds: nodal tension, friction and slip, and the two speeds
@@ -498,13 +557,8 @@ class _Monitor:
         final.update(power_terms(y, flds, cdot, lay, mesh, P, rim1, m2))
         if self.snapshot_interval and (not self.snaps["t"] or self.snaps["t"][-1] < t):
             _snapshot(self.snaps, t, flds, final)
-        try:
-            ana = analytic_of(P)
-        except NoSolutionError:
-            ana = None
         return DriveResult(self.scene, self.num, status, reason, mesh.x.copy(), flds, final,
                            history={k: np.asarray(v) for k, v in self.hist.items()},
-                           analytic=ana,
                            snapshots={k: np.asarray(v) for k, v in self.snaps.items()},
                            wall_time=wall, statistics=statistics)
 

@@ -17,6 +17,9 @@ from .model import LoopMesh, LoopParams, Rates, assemble, max_triplets
 #: update: round-off level (the semi-smooth Newton can flip a front node back and forth
 #: at that level)
 RESIDUAL_TOL = 1e-13
+#: a scaled residual of root mean square below this that a full step no longer halves is
+#: at its round-off floor
+FLOOR_TOL = 1e-9
 
 
 @njit(cache=True)
@@ -186,9 +189,12 @@ def newton(sys_: System, y, rates, rim1, load, tol=1e-10, max_iterations=40):
             new = np.linalg.norm(sys_.residual(trial, rates, rim1, load) / sys_.rscale)
         y[:] = trial
         _clip_ratios(y, lay, regular)
+        # at round-off the residual stops falling: its floor grows as the stiffness b1 / h
+        # of fine grids, so a small residual that a full step no longer halves is converged
+        stalled = step == 1.0 and new > 0.5 * merit and new < FLOOR_TOL * np.sqrt(len(y))
         merit = new
         small = merit < RESIDUAL_TOL * np.sqrt(len(y))
-        if step == 1.0 and np.max(np.abs(dy) / sys_.yscale) < tol or small:
+        if step == 1.0 and np.max(np.abs(dy) / sys_.yscale) < tol or small or stalled:
             return it
     raise NumericalError(f"the drive's Newton iteration did not converge in "
                          f"{max_iterations} iterations (scaled residual {merit:.3g})",
