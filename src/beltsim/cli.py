@@ -68,8 +68,23 @@ def _drive_run(args, scene):
     from .beltdrive.run import DriveStatus, simulate
 
     out = Path(args.out or Path("runs/out") / Path(args.scene).stem)
-    result = simulate(scene, snapshot_interval=args.snapshots
-                      or scene.numerics.get("snapshot_interval"))
+    bar = progress = None
+    if _progress(args):
+        from tqdm.auto import tqdm
+
+        from .beltdrive.run import resolve
+
+        bar = tqdm(total=resolve(scene).t_end, unit="s", desc="simulated time",
+                   bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}]")
+
+        def progress(t, t_end):
+            bar.update(t - bar.n)
+    try:
+        result = simulate(scene, progress=progress, snapshot_interval=args.snapshots
+                          or scene.numerics.get("snapshot_interval"))
+    finally:
+        if bar is not None:
+            bar.close()
     save_drive_run(result, out)
     summary = result_summary(result)
     print(format_drive(summary, title=scene.title or args.scene))
