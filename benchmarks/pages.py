@@ -43,8 +43,9 @@ SCENE = "paper_slip"
 #: (grid or None for the default, repeats, transient peers' wall cap in s, grid ladder)
 MODES = {False: (None, 3, 600.0, (250, 600, 1000, 2000)), True: (40, 1, 60.0, (20, 40, 60))}
 #: the closed drive's bench (benchmarks.drive), by mode: its options
-DRIVE_ARGS = {False: ["--peer-cap", "200"], True: ["--elements", "40", "--repeat", "1", "--grids", "3",
-                                "--peers", "newton,lm,bdf2,radau", "--peer-cap", "60"]}
+DRIVE_ARGS = {False: ["--peer-cap", "200"],
+              True: ["--elements", "40", "--repeat", "1", "--grids", "3",
+                     "--peers", "newton,lm,bdf2,radau", "--peer-cap", "60"]}
 TITLE = "Timings"
 INDEX_INTRO = (
     "How fast beltsim runs, measured by `python -m benchmarks.pages` on the machine its "
