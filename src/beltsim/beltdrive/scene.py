@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import copy
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +36,7 @@ from ..problem.scene import (
     check_table,
     final_value,
     parse_assignment,
+    parse_toml,
 )
 from .geometry import Geometry, GeometryError
 
@@ -308,11 +308,7 @@ class DriveScene:
     @classmethod
     def loads(cls, text: str, source: str | None = None) -> DriveScene:
         """Parse and validate a drive scene from TOML text."""
-        try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise SceneError(f"{source or 'scene'}: malformed TOML ({exc})") from None
-        return cls(data, source=source)
+        return cls(parse_toml(text, source), source=source)
 
     @classmethod
     def from_dict(cls, data: dict) -> DriveScene:

@@ -558,11 +558,7 @@ class Scene:
         SceneError
             Malformed TOML or a broken rule.
         """
-        try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise SceneError(f"{source or 'scene'}: malformed TOML ({exc})") from None
-        return cls(data, source=source)
+        return cls(parse_toml(text, source), source=source)
 
     @classmethod
     def from_dict(cls, data: dict) -> Scene:
@@ -773,6 +769,14 @@ class Scene:
         return f"Scene({self.title or self.source or 'untitled'!r})"
 
 
+def parse_toml(text: str, source: str | None = None) -> dict:
+    """A scene file's TOML text as tables, or the one-line error of malformed TOML."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{source or 'scene'}: malformed TOML ({exc})") from None
+
+
 def _frozen(value):
     """A scene's tables as nested sorted tuples, which hash (equal tables, equal tuples)."""
     if isinstance(value, dict):
@@ -897,10 +901,7 @@ def _loads_any(text: str, source: str):
     """A Scene, or a DriveScene where the text has a [drive] section (a closed drive)."""
     from ..beltdrive.scene import DriveScene, is_drive
 
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{source or 'scene'}: malformed TOML ({exc})") from None
+    data = parse_toml(text, source)
     return DriveScene(data, source=source) if is_drive(data) else Scene(data, source=source)
 
 
