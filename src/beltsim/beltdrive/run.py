@@ -13,7 +13,7 @@ import numpy as np
 from ..errors import NoSolutionError, NumericalError, SceneError
 from ..physics.friction import EXACT, saturation
 from ..problem.drive import Profile, _profile, value
-from .analytic import capacity, solve_string
+from .analytic import solve_string
 from .discrete import (
     DEFAULT_ELEMENTS,
     Layout,
@@ -120,10 +120,6 @@ def profiles(scene: DriveScene, ramp_time: float) -> tuple[Profile, Profile]:
     R1 = scene.params.geometry.R1
     return (_profile(d["driver_speed"], 0.0, 1.0 / R1, ramp_time),
             _profile(d["load_torque"], 0.0, 1.0, ramp_time))
-
-
-class Fields(dict):
-    """Nodal arrays of a drive's state (a dict of name -> array)."""
 
 
 def fields_of(y, lay: Layout, mesh: LoopMesh, P: DriveParams, prm, rim1: float,
@@ -710,7 +706,3 @@ def _run_explicit(mon: _Monitor, prm, speed, load) -> DriveResult:
     return mon.result(status, reason, t, y, vu, vt, state[2],
                       {"steps": steps, "dt": dt})
 
-
-def drive_capacity(scene: DriveScene) -> float:
-    """The string's capacity (N m) at the scene's final driver speed."""
-    return capacity(scene.params)

@@ -22,7 +22,6 @@ from __future__ import annotations
 import copy
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 from ..errors import NoSolutionError, SceneError
 from ..problem.scene import (
@@ -37,7 +36,9 @@ from ..problem.scene import (
     final_value,
     parse_assignment,
     parse_toml,
+    read_scene_file,
 )
+from ..problem.scene import SCHEMA as STRAIGHT_SCHEMA
 from .geometry import Geometry, GeometryError
 
 #: The fewest elements on each of the loop's four segments.
@@ -64,21 +65,9 @@ class _LoadRule(_Rule):
 
 #: Sections of a drive scene, their keys and rules.
 SCHEMA: dict[str, dict[str, _Rule]] = {
-    "belt": {
-        "height": POS,
-        "width": POS,
-        "youngs_modulus": POS,
-        "poisson_ratio": _Rule("float", interval=(-1.0, 0.5)),
-        "density": POS,
-        "shear_factor": POS,
-    },
-    "stiffness": {
-        "bending": POS,
-        "tension": POS,
-        "shear": POS,
-        "mass": POS,
-        "rotary_inertia": POS,
-    },
+    # the straight belt's [beam] keys but its length (the loop's follows from the drive)
+    "belt": {k: rule for k, rule in STRAIGHT_SCHEMA["beam"].items() if k != "length"},
+    "stiffness": dict(STRAIGHT_SCHEMA["stiffness"]),
     "drive": {
         "driver_radius": POS,
         "driven_radius": POS,
@@ -296,14 +285,7 @@ class DriveScene:
     @classmethod
     def load(cls, path) -> DriveScene:
         """Read and validate a drive scene file (TOML)."""
-        path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise SceneError(f"{path}: scene file not found") from None
-        except (OSError, UnicodeDecodeError) as exc:
-            raise SceneError(f"{path}: cannot read scene file ({exc})") from None
-        return cls.loads(text, source=str(path))
+        return cls.loads(read_scene_file(path), source=str(path))
 
     @classmethod
     def loads(cls, text: str, source: str | None = None) -> DriveScene:

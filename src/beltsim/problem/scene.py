@@ -523,20 +523,7 @@ class Scene:
         SceneError
             The file is missing or unreadable, not TOML, or breaks a rule.
         """
-        path = Path(path)
-        try:
-            text = path.read_bytes()
-        except FileNotFoundError:
-            raise SceneError(f"{path}: scene file not found") from None
-        except IsADirectoryError:
-            raise SceneError(f"{path}: is a directory, not a scene file") from None
-        except OSError as exc:
-            raise SceneError(f"{path}: cannot read scene file ({exc.strerror})") from None
-        try:
-            text = text.decode("utf-8")
-        except UnicodeDecodeError:
-            raise SceneError(f"{path}: not a UTF-8 text file") from None
-        return cls.loads(text, source=str(path))
+        return cls.loads(read_scene_file(path), source=str(path))
 
     @classmethod
     def loads(cls, text: str, source: str | None = None) -> Scene:
@@ -769,6 +756,24 @@ class Scene:
         return f"Scene({self.title or self.source or 'untitled'!r})"
 
 
+def read_scene_file(path) -> str:
+    """A scene file's text, or the one-line error of a missing, unreadable or non-UTF-8
+    file."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise SceneError(f"{path}: scene file not found") from None
+    except IsADirectoryError:
+        raise SceneError(f"{path}: is a directory, not a scene file") from None
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read scene file ({exc.strerror})") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise SceneError(f"{path}: not a UTF-8 text file") from None
+
+
 def parse_toml(text: str, source: str | None = None) -> dict:
     """A scene file's TOML text as tables, or the one-line error of malformed TOML."""
     try:
@@ -916,12 +921,7 @@ def load_scene(path_or_name, overrides=()) -> Scene:
     if not Path(text).exists() and "/" not in text and "\\" not in text \
             and not text.endswith(".toml"):
         return shipped_scene(text, overrides)
-    path = Path(path_or_name)
-    try:
-        text = path.read_bytes().decode("utf-8")
-    except (OSError, UnicodeDecodeError):
-        return Scene.load(path)  # its one-line messages for missing and unreadable files
-    scene = _loads_any(text, source=str(path))
+    scene = _loads_any(read_scene_file(path_or_name), source=str(path_or_name))
     return scene.with_overrides(overrides) if overrides else scene
 
 
