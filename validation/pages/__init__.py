@@ -41,12 +41,13 @@ INDEX_INTRO = (
 
 def _pages():
     """(name, title, build) of every page, in reading order."""
-    from . import balance, convergence, drive, end_states, paper, paths, stability
+    from . import balance, convergence, drive, end_states, paper, paths, spectrum, stability
 
     return (("paper", paper.TITLE, paper.build),
             ("end_states", end_states.TITLE, end_states.build),
             ("convergence", convergence.TITLE, convergence.build),
             ("paths", paths.TITLE, paths.build),
+            ("spectrum", spectrum.TITLE, spectrum.build),
             ("stability", stability.TITLE, stability.build),
             ("balance", balance.TITLE, balance.build),
             ("drive", drive.TITLE, drive.build))

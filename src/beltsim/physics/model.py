@@ -48,6 +48,12 @@ from .friction import (
     law_inverse,
 )
 
+#: The gyroscopic term's forms (``numerics.gyroscopic``): first-order upwind, which damps
+#: the spans' modes numerically, or the Galerkin (skew) form, second order and without
+#: numerical damping (docs/theory/discretisation.md, "The gyroscopic term").
+UPWIND, CENTRAL = 0, 1
+GYROSCOPIC_FORMS = {"upwind": UPWIND, "central": CENTRAL}
+
 # |lam| bound in the primal-dual iteration: the friction of a fully sliding node is
 # then f* (1 - 1e-14), and g^{-1} stays finite
 LAM_MAX = 1.0 - 1e-14
@@ -68,6 +74,7 @@ class ModelParams(NamedTuple):
     regularisation: float  # the law's velocity scale: v_reg; v_aug for the exact laws
     law: int  # friction law code (friction.LAW_CODES)
     dual: int  # 1: the friction ratio is a Newton unknown (primal-dual form)
+    gyro: int = 0  # the gyroscopic term's form: UPWIND or CENTRAL
 
 
 class Mesh(NamedTuple):
@@ -171,14 +178,16 @@ def load_at(q, dq, k, w0, w1, v0, v1, j):
     return w0 * q[k, j] + w1 * q[k + 1, j] + v0 * dq[k, j] + v1 * dq[k + 1, j]
 
 
-def model_params(P, damping, friction_scale, regularisation, law_code) -> ModelParams:
-    """The model's coefficients from the physical parameters and the friction settings."""
+def model_params(P, damping, friction_scale, regularisation, law_code,
+                 gyro=UPWIND) -> ModelParams:
+    """The model's coefficients from the physical parameters, the friction settings and
+    the gyroscopic term's form (UPWIND or CENTRAL)."""
     # the linear law's dual and primal forms coincide; saturating laws need the dual
     dual = int(has_dual(law_code) and law_code != LINEAR)
     return ModelParams(
         B=P.B, A=P.A, shear=P.b2, mass=P.rho, rotary_inertia=P.I,
         speed=P.c, half_height=0.5 * P.h, damping=damping, friction_scale=friction_scale,
-        regularisation=regularisation, law=law_code, dual=dual)
+        regularisation=regularisation, law=law_code, dual=dual, gyro=gyro)
 
 
 def regularised(p: ModelParams) -> ModelParams:
@@ -233,17 +242,28 @@ def bottom_strain(u, th, hh, sw, j):
 
 
 @njit(cache=True, inline="always")
+def gyro_weights(hbj, hl, p):
+    """(diagonal, lower, upper) weights of the gyroscopic term 2 c v_x over node j's
+    control volume, per unit mass: upwind 2 c hbar_j (v_j - v_{j-1}) / h_{j-1}, or the
+    Galerkin form of linear elements c (v_{j+1} - v_{j-1}), skew-symmetric on any grid."""
+    if p.gyro == CENTRAL:
+        return 0.0, -p.speed, p.speed
+    g = 2.0 * p.speed * hbj / hl
+    return g, -g, 0.0
+
+
+@njit(cache=True, inline="always")
 def rate_blocks(hbj, hl, inv_dt, p):
     """The terms in inv_dt of interior row j's Jacobian (its time-derivative part), but
     for friction: the lumped inertia and damping m_j (inv_dt^2 + d inv_dt) and the
-    upwind gyroscopic term m_j (2 c / h_{j-1}) inv_dt (v_j - v_{j-1}), m_j = rho hbar_j
-    in the u row and I hbar_j in the theta row. Returns the (diagonal, lower) entries of
-    the u row and of the theta row."""
+    gyroscopic term (:func:`gyro_weights`) times inv_dt, m_j = rho hbar_j in the u row
+    and I hbar_j in the theta row. Returns the (diagonal, lower, upper) entries of the u
+    row and of the theta row."""
     kin = inv_dt * inv_dt + p.damping * inv_dt  # d(acc + damp * vel)/dy
-    gyro = 2.0 * p.speed * hbj / hl
+    g0, gl, gu = gyro_weights(hbj, hl, p)
     rho, I = p.mass, p.rotary_inertia
-    return (rho * hbj * kin + rho * gyro * inv_dt, -rho * gyro * inv_dt,
-            I * hbj * kin + I * gyro * inv_dt, -I * gyro * inv_dt)
+    return (rho * hbj * kin + rho * g0 * inv_dt, rho * gl * inv_dt, rho * gu * inv_dt,
+            I * hbj * kin + I * g0 * inv_dt, I * gl * inv_dt, I * gu * inv_dt)
 
 
 @njit(cache=True, inline="always")
@@ -309,12 +329,14 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
         tdj = (th[j] - tho[j]) * inv_dt
         ud_l = (u[j - 1] - uo[j - 1]) * inv_dt
         td_l = (th[j - 1] - tho[j - 1]) * inv_dt
-        gyro = 2.0 * c * hbj / hl  # upwind 2 c u_xt over the control volume
+        ud_r = (u[j + 1] - uo[j + 1]) * inv_dt
+        td_r = (th[j + 1] - tho[j + 1]) * inv_dt
+        g0, gl, gu = gyro_weights(hbj, hl, p)  # 2 c u_xt over the control volume
         acc_u = (udj - udo[j]) * inv_dt + damp * udj
         acc_t = (tdj - tdo[j]) * inv_dt + damp * tdj
-        ru = (rho * hbj * acc_u + rho * gyro * (udj - ud_l)
+        ru = (rho * hbj * acc_u + rho * (g0 * udj + gl * ud_l + gu * ud_r)
               - B * ((u[j + 1] - u[j]) / hr - (u[j] - u[j - 1]) / hl))
-        rt = (I * hbj * acc_t + I * gyro * (tdj - td_l)
+        rt = (I * hbj * acc_t + I * (g0 * tdj + gl * td_l + gu * td_r)
               - A * ((th[j + 1] - th[j]) / hr - (th[j] - th[j - 1]) / hl) + b2 * hbj * th[j])
         if lk >= 0:
             ru -= hbj * load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j)
@@ -329,13 +351,13 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
                         L2[i, a_, b_] = 0.0
                         Db[i, a_, b_] = 0.0
                         Ub[i, a_, b_] = 0.0
-            du, lu, dt_, lt = rate_blocks(hbj, hl, inv_dt, p)
+            du, lu, uu, dt_, lt, ut = rate_blocks(hbj, hl, inv_dt, p)
             Db[i, 0, 0] = du + B * (1.0 / hl + 1.0 / hr)
             Lb[i, 0, 0] = lu - B / hl
-            Ub[i, 0, 0] = -B / hr
+            Ub[i, 0, 0] = uu - B / hr
             Db[i, 1, 1] = dt_ + A * (1.0 / hl + 1.0 / hr) + b2 * hbj
             Lb[i, 1, 1] = lt - A / hl
-            Ub[i, 1, 1] = -A / hr
+            Ub[i, 1, 1] = ut - A / hr
         if j >= c0 and j <= j2:
             # slip velocity at node j (stencil sw[j]), friction on its weight wf[j]
             ub = u[j] + hh * th[j]
@@ -379,11 +401,13 @@ def rate_part(e, a0, fs, sg, mesh, p, out):
     he, hb, hh = mesh.he, mesh.hb, p.half_height
     for i in range(e.shape[0]):
         j = i + 1
-        du, lu, dt_, lt = rate_blocks(hb[j], he[j - 1], a0, p)
+        du, lu, uu, dt_, lt, ut = rate_blocks(hb[j], he[j - 1], a0, p)
         ul = e[i - 1, 0] if i > 0 else 0.0
         tl = e[i - 1, 1] if i > 0 else 0.0
-        out[i, 0] = du * e[i, 0] + lu * ul
-        out[i, 1] = dt_ * e[i, 1] + lt * tl
+        ur = e[i + 1, 0] if i + 1 < e.shape[0] else 0.0
+        tr = e[i + 1, 1] if i + 1 < e.shape[0] else 0.0
+        out[i, 0] = du * e[i, 0] + lu * ul + uu * ur
+        out[i, 1] = dt_ * e[i, 1] + lt * tl + ut * tr
         if mesh.c0 <= j <= mesh.j2:
             k = friction_stiffness(mesh.wf[j], fs, sg[j], p) * own_rate_slope(2, a0)
             eb = e[i, 0] + hh * e[i, 1]
@@ -509,9 +533,9 @@ def power_terms(state, t, mesh, p, drive, loads, out):
                              + load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j) * td[j])
     gyro = 0.0
     for j in range(1, u.shape[0] - 1):
-        g = 2.0 * c * hb[j] / he[j - 1]
-        gyro += g * (p.mass * ud[j] * (ud[j] - ud[j - 1])
-                     + p.rotary_inertia * td[j] * (td[j] - td[j - 1]))
+        g0, gl, gu = gyro_weights(hb[j], he[j - 1], p)
+        gyro += (p.mass * ud[j] * (g0 * ud[j] + gl * ud[j - 1] + gu * ud[j + 1])
+                 + p.rotary_inertia * td[j] * (g0 * td[j] + gl * td[j - 1] + gu * td[j + 1]))
     out[0], out[1], out[2], out[3], out[4], out[5] = (surface, transport, load, slip,
                                                       damping, gyro)
 

@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from ..problem.drive import friction_factor, mismatch
 from .friction import ADHESION, AUGMENTATION, is_exact, law_numpy
-from .model import POWER_TERMS, Mesh, ModelParams, State, hermite_weights
+from .model import CENTRAL, POWER_TERMS, Mesh, ModelParams, State, hermite_weights
 
 
 class Operators(NamedTuple):
@@ -119,6 +119,22 @@ def loads_at(loads, t, n_nodes):
                  for q, dq in ((loads.qu, loads.dqu), (loads.qt, loads.dqt)))
 
 
+def gyroscopic(mesh: Mesh, p: ModelParams):
+    """(g0, gl, gu): the gyroscopic term 2 c v_x over each interior node's control volume
+    per unit mass, g0 v_j + gl v_{j-1} + gu v_{j+1}: upwind, or the skew Galerkin form."""
+    n = len(mesh.he) - 1
+    if p.gyro == CENTRAL:
+        return np.zeros(n), np.full(n, -p.speed), np.full(n, p.speed)
+    g = 2.0 * p.speed * mesh.hb[1:-1] / mesh.he[:-1]
+    return g, -g, np.zeros(n)
+
+
+def _gyro_force(v, g):
+    """The gyroscopic term of the nodal rates v (N + 1) at the interior nodes."""
+    g0, gl, gu = g
+    return g0 * v[1:-1] + gl * v[:-2] + gu * v[2:]
+
+
 def forces(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, loads=None, ratios=None):
     """f of M q'' = f: the forces on u and the moments on theta at the interior nodes
     (n, 2), all but the inertia terms; and the nodal friction forces F (N + 1).
@@ -131,13 +147,13 @@ def forces(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, loads=None, rati
     F, _ = friction(slip_velocity(u, th, ud, td, t, mesh, p, drive), t, mesh, p, drive,
                     ratios)
     sl = slice(1, -1)
-    gyro = 2.0 * c * hb[sl] / he[:-1]  # upwind 2 c u_xt over the control volume
+    g = gyroscopic(mesh, p)
     qu, qt = loads_at(loads, t, len(u))
     f = np.empty((len(u) - 2, 2))
-    f[:, 0] = (B * np.diff(np.diff(u) / he) - rho * gyro * (ud[sl] - ud[:-2])
+    f[:, 0] = (B * np.diff(np.diff(u) / he) - rho * _gyro_force(ud, g)
                - p.damping * rho * hb[sl] * ud[sl] + F[sl] + hb[sl] * qu[sl])
     f[:, 1] = (A * np.diff(np.diff(th) / he) - b2 * hb[sl] * th[sl]
-               - I * gyro * (td[sl] - td[:-2]) - p.damping * I * hb[sl] * td[sl]
+               - I * _gyro_force(td, g) - p.damping * I * hb[sl] * td[sl]
                + hh * F[sl] + hb[sl] * qt[sl])
     return f, F
 
@@ -163,14 +179,14 @@ def operators(mesh: Mesh, p: ModelParams) -> Operators:
     n = len(he) - 1
     hl, hr, hbi = he[:-1], he[1:], hb[1:-1]
     rho, I = p.mass, p.rotary_inertia
-    gyro = 2.0 * p.speed * hbi / hl
+    g0, gl, gu = gyroscopic(mesh, p)
     stiffness = _matrix(n, [_fields(n, 0, p.B * (1.0 / hl + 1.0 / hr),
                                     p.A * (1.0 / hl + 1.0 / hr) + p.shear * hbi),
                             _fields(n, -1, -p.B / hl, -p.A / hl),
                             _fields(n, 1, -p.B / hr, -p.A / hr)])
-    damping = _matrix(n, [_fields(n, 0, rho * gyro + p.damping * rho * hbi,
-                                  I * gyro + p.damping * I * hbi),
-                          _fields(n, -1, -rho * gyro, -I * gyro)])
+    damping = _matrix(n, [_fields(n, 0, rho * g0 + p.damping * rho * hbi,
+                                  I * g0 + p.damping * I * hbi),
+                          _fields(n, -1, rho * gl, I * gl), _fields(n, 1, rho * gu, I * gu)])
     return Operators(interleave(rho * hbi, I * hbi), stiffness, damping)
 
 
@@ -250,7 +266,7 @@ def power_terms(state: State, t, mesh: Mesh, p: ModelParams, drive, loads=None):
     vrel = ud[j] + hh * td[j] + c * strain_b - target
     sl = slice(1, -1)
     qu, qt = loads_at(loads, t, len(u))
-    gyro = 2.0 * c * hb[sl] / he[:-1]
+    g = gyroscopic(mesh, p)
     terms = {
         "surface": target * F[j].sum(),
         "transport": -c * np.sum(F[j] * strain_b),
@@ -258,7 +274,7 @@ def power_terms(state: State, t, mesh: Mesh, p: ModelParams, drive, loads=None):
         "slip": -np.sum(F[j] * vrel),
         "damping": p.damping * np.sum(hb[sl] * (p.mass * ud[sl] ** 2
                                                 + p.rotary_inertia * td[sl] ** 2)),
-        "gyroscopic": np.sum(gyro * (p.mass * ud[sl] * (ud[sl] - ud[:-2])
-                                     + p.rotary_inertia * td[sl] * (td[sl] - td[:-2]))),
+        "gyroscopic": np.sum(p.mass * ud[sl] * _gyro_force(ud, g)
+                             + p.rotary_inertia * td[sl] * _gyro_force(td, g)),
     }
     return np.array([terms[name] for name in POWER_TERMS])

@@ -303,6 +303,10 @@ class NumericsSection(Section):
         Newton iterations per step before the step is cut.
     max_work : float, optional
         The explicit scheme's most node-steps before it refuses a run.
+    gyroscopic : str, optional
+        The gyroscopic term's form: ``"upwind"`` (default; first order, damps the spans'
+        modes numerically) or ``"central"`` (second order, no numerical damping;
+        implicit schemes only).
     """
 
     section = "numerics"
@@ -322,6 +326,7 @@ class NumericsSection(Section):
     newton_tol: float | None = None
     newton_max_iterations: int | None = None
     max_work: float | None = None
+    gyroscopic: str | None = None
 
 
 #: The section classes by their names in a scene file, in the file's order.

@@ -224,6 +224,7 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "newton_tol": POS,
         "newton_max_iterations": _Rule("int", minimum=1),
         "max_work": POS,
+        "gyroscopic": _Rule("str", choices=("upwind", "central")),
     },
 }
 
@@ -236,7 +237,7 @@ _ONLY_COULOMB = {("contact", "max_friction"), ("numerics", "regularisation")}
 _ONLY_STICK = {("numerics", "adhesion_layer")}
 # (physics.damping, like beam.density, describes the belt and is ignored without inertia)
 _ONLY_INERTIA = {("stiffness", "mass"), ("stiffness", "rotary_inertia"),
-                 ("numerics", "acceleration")}
+                 ("numerics", "acceleration"), ("numerics", "gyroscopic")}
 # Keys of required sections that may be left out (default in Params).
 _OPTIONAL_KEYS = {("physics", "damping")}
 # Keys that were, and what replaces them.

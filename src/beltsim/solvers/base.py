@@ -47,7 +47,7 @@ class Discretisation:
         self.mesh: Mesh = mesh_of(self.grid)
         self.model: ModelParams = model_params(P, P.damping + num.acceleration,
                                                num.friction_scale, num.regularisation,
-                                               num.law_code)
+                                               num.law_code, num.gyro_code)
         self.drive = drive_of(scene, num.ramp_time)
         self.loads: Loads = Loads.none(self.grid.n_elements + 1)
         self.scales: Scales = scales_of(P)

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from ..errors import SceneError
 from ..physics.friction import AUGMENTATION, LAW_CODES
 from ..physics.grid import Grid, make_grid
+from ..physics.model import GYROSCOPIC_FORMS
 from ..problem import analytic
 from ..problem.analytic import decay_rates
 from ..problem.drive import largest_mismatch, period_of, profile_times, speed_ramped
@@ -76,6 +77,12 @@ class Numerics:
     time_tol: float = DEFAULT_TIME_TOL
     max_work: float = DEFAULT_MAX_WORK
     settle_time: float = 0.0  # when the drive stops changing (steady tests start there)
+    gyroscopic: str = "upwind"  # the gyroscopic term's form (physics.model.GYROSCOPIC_FORMS)
+
+    @property
+    def gyro_code(self) -> int:
+        """The gyroscopic form's code as the kernels read it."""
+        return GYROSCOPIC_FORMS[self.gyroscopic]
 
     @property
     def law_code(self) -> int:
@@ -146,6 +153,10 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
     if accelerated and P.inertia:
         omega1 = math.pi * P.B / (P.L * math.sqrt(P.rho * P.b1))
         acceleration = nm.get("acceleration", 2.0 * omega1)
+    gyroscopic = nm.get("gyroscopic", "upwind")
+    if gyroscopic != "upwind" and integrator == "explicit":
+        raise SceneError("numerics.gyroscopic", '"central" is for the implicit schemes; the '
+                         'explicit scheme has the upwind form only')
     if "max_work" in nm and integrator != "explicit":
         raise SceneError("numerics.max_work", 'only for numerics.integrator = "explicit" (the '
                          "other schemes' steps adapt)")
@@ -163,6 +174,7 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         time_tol=nm.get("time_tol", DEFAULT_TIME_TOL),
         settle_time=settle_time(scene, ramp_time),
         max_work=nm.get("max_work", DEFAULT_MAX_WORK),
+        gyroscopic=gyroscopic,
     )
 
 
