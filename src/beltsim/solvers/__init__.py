@@ -3,7 +3,7 @@
 Importing this package registers every scheme (see :mod:`beltsim.solvers.base`).
 """
 
-from . import explicit, implicit, pseudo, steady  # noqa: F401  (each registers its scheme)
+from . import esdirk, explicit, implicit, pseudo, steady  # noqa: F401  (each registers its scheme)
 from .base import Discretisation, Scheme
 from .registry import applicable, get, names, register
 
