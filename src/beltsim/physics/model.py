@@ -8,10 +8,13 @@ speed c, and D/Dt = d/dt + c d/dx. With B = b1 - rho c^2 and A = a - I c^2::
     f = -f_s g(v_rel / v_reg),  v_rel = d/dt u_b + c d/dx u_b - (v(t) - c),  u_b = u + (h/2) theta
 
 Space: linear elements with lumped mass and shear (node-centred control
-volumes); the gyroscopic term 2 c u_xt is upwind, 2 rho c hbar_j (v_j - v_{j-1}) /
-h_{j-1}: the central, skew form leaves a mode that grows at the paper slip steady state
-(friction in the stick zone pumps the rotation), the upwind one damps it, and both
-vanish at steady state. The transport c d/dx u_b in the slip velocity is evaluated at
+volumes). The gyroscopic term 2 c u_xt has two forms (numerics.gyroscopic): upwind,
+2 rho c hbar_j (v_j - v_{j-1}) / h_{j-1}, first order, which damps the spans' modes
+numerically; or the Galerkin form of linear elements, rho c (v_{j+1} - v_{j-1}), skew,
+second order and without numerical damping. The exact spectrum (physics.continuum) has
+growing modes at the paper's steady states: the central form reproduces them, the upwind
+one damps them, and that is why the paper's scenes settle with it. Both vanish at steady
+state. The transport c d/dx u_b in the slip velocity is evaluated at
 the contact nodes x1 .. x2 with the one-sided three-point (BDF2) derivative over
 x_{j-2}, x_{j-1}, x_j (second order on any grid; upwind, so its parasitic solution
 decays by ~1/3 per node downstream and never alternates), and the friction of node j
@@ -502,8 +505,9 @@ def traction(fnode, wf):
 # v_rel = d/dt u_b + c d/dx u_b - (v(t) - c): the slip dissipation D_slip = -sum F v_rel
 # (>= 0), the surface's power P_surface = (v(t) - c) sum F, and the transport part
 # P_transport = -c sum F d/dx u_b (the strain carried through the contact), and
-# D_gyroscopic = sum v_j 2 rho c hbar_j (v_j - v_{j-1}) / h_{j-1} (+ theta), the upwind
-# gyroscopic term's dissipation plus the flux out at x = L (>= 0 on a uniform grid).
+# D_gyroscopic = sum v_j G_j(v) (+ theta), G the gyroscopic term (gyro_weights): the
+# upwind form's dissipation plus the flux out at x = L (>= 0 on a uniform grid), or 0 for
+# the skew central form.
 POWER_TERMS = ("surface", "transport", "loads", "slip", "damping", "gyroscopic")
 
 

@@ -60,12 +60,12 @@ def scheme_label(scene) -> str:
     Returns
     -------
     str
-        E.g. ``"implicit (time-accurate), damping 39 1/s"``.
+        E.g. ``"esdirk3 (time-accurate), damping 39 1/s"``.
     """
     from .. import solvers
     from ..solvers.settings import resolve
 
-    name = scene.numerics.get("integrator", "implicit")
+    name = resolve(scene).integrator
     kind = "time-accurate" if solvers.get(name).time_accurate else "pseudo-transient path"
     damping = scene.params.damping
     text = f"{name} ({kind}), damping {damping:g} 1/s" if scene.params.inertia else (

@@ -15,6 +15,7 @@ from .common import panel_axes
 #: the resolutions the CLI saves the two figures at
 ERROR_VS_RUNTIME_DPI, CREEP_COLLAPSE_DPI = 130, 110
 SCHEME_STYLE = {"explicit": ("tab:red", "s"), "implicit": ("tab:blue", "o"),
+                "esdirk3": ("tab:orange", "v"),
                 "steady": ("tab:green", "^"), "richardson": ("tab:purple", "D")}
 
 

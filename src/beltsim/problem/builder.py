@@ -271,8 +271,8 @@ class NumericsSection(Section):
     Parameters
     ----------
     integrator : str, optional
-        A registered scheme: ``"implicit"`` (default), ``"explicit"``, ``"pseudo"``,
-        ``"steady"``.
+        A registered scheme: ``"esdirk3"`` (default), ``"implicit"``, ``"explicit"``,
+        ``"pseudo"``, ``"steady"``.
     elements : int, optional
         Number of elements (at least 6).
     grading : float, optional
