@@ -79,7 +79,8 @@ class SteadyScheme(NewtonScheme):
         this scheme's (and each grid's apart, ``grid_iterations``).
 
         Raises NumericalError when a stage from rest falls below MIN_STAGE of the
-        mismatch.
+        mismatch, or Newton does not converge from a coarser grid's steady state (on
+        grids so fine that its update stalls above its round-off floor).
         """
         d = self.disc
         if d.grid.n_elements <= COARSEST * default_elements(d.params):
@@ -100,10 +101,11 @@ class SteadyScheme(NewtonScheme):
         before = int(stats["newton_iterations"])
         interpolate(coarse.grid, coarse_state, d.grid, state)
         if not self._stage(state, 1.0, self._stage_settings):
-            # not in Newton's reach from the coarse grid's state: from rest, as on a
-            # coarse grid (the stages of continuation cost iterations, not the result)
-            state.assign(d.new_state())
-            self._solve_from_rest(state)
+            raise NumericalError(
+                f"steady Newton iteration on {d.grid.n_elements} elements did not converge "
+                f"from the steady state of {coarse.grid.n_elements} elements (residual "
+                f"norm {stats['merit']:.3g})",
+                kind=FailureKind.CONTINUATION, t=0.0, quantity="newton")
         self.grid_iterations = [*level.grid_iterations,
                                 int(stats["newton_iterations"]) - before]
 
