@@ -162,12 +162,12 @@ def coarsened(grid: Grid, factor: int) -> tuple[Grid, np.ndarray]:
 
     Each segment between 0, x1, x2 and L keeps about every factor-th of its nodes
     (evenly spaced in index, so the coarse grid is graded as the fine one), its ends
-    among them, and at least two elements.
+    among them, and at least two elements (all it has, if fewer).
     """
     ends = (0, grid.j1, grid.j2, grid.n_elements)
     parts = []
     for a, b in zip(ends[:-1], ends[1:]):
-        k = max(2, round((b - a) / factor))
+        k = min(b - a, max(2, round((b - a) / factor)))
         parts.append(np.rint(np.linspace(a, b, k + 1)).astype(np.int64)[:-1])
     index = np.concatenate([*parts, [grid.n_elements]])
     j1, j2 = np.searchsorted(index, [grid.j1, grid.j2])
