@@ -1,35 +1,59 @@
-"""Steady scheme: Newton on the discrete equations with d/dt = 0, from rest.
+"""Steady scheme: Newton on the discrete equations with d/dt = 0.
 
-The surface speed goes from c to v in stages of continuation (the mismatch
-v - c scaled by s in (0, 1]): a stage that converges doubles the next one, a
-failed stage is undone and retried with a quarter of its size. A saturating friction
-law is first solved with a regularisation velocity REGULARISATION_START times the
-scene's (smooth friction, few iterations) and then with the scene's from there, which
-takes fewer Newton iterations than the scene's law from rest. It lands on the same
-discrete steady state as the transient schemes (docs/theory/time-schemes.md).
+On a grid up to COARSEST times the scene's default elements, Newton starts from rest.
+The surface speed goes from c to v in stages of continuation (the mismatch v - c
+scaled by s in (0, 1]): a stage that converges doubles the next one, a failed stage is
+undone and retried with a quarter of its size. A saturating friction law is first
+solved with a regularisation velocity REGULARISATION_START times the scene's (smooth
+friction, few iterations) and then with the scene's from there, which takes fewer
+Newton iterations than the scene's law from rest.
+
+From rest, Newton moves a slip front by about a node an iteration, so its iterations
+grow with the grid. A finer grid therefore starts from the steady state of one
+COARSENING times coarser (every COARSENING-th node of its own), interpolated: the
+front is then within a few nodes of its place, and Newton needs a few iterations per
+grid whatever its size. Every grid solves the scene's model (the finest grid's
+regularisation), so the iterate lands on the same discrete steady state as the
+transient schemes (docs/theory/time-schemes.md).
 """
 
 from __future__ import annotations
 
+import copy
+
+import numpy as np
+
 from ..errors import FailureKind, NumericalError
 from ..physics.friction import is_exact
-from ..physics.model import regularised
+from ..physics.grid import Grid
+from ..physics.model import Loads, mesh_of, regularised
 from ..problem.drive import Drive
 from .newton import NewtonScheme, NewtonSettings, newton
 from .registry import register
+from .settings import default_elements
 
 MIN_STAGE = 1e-6  # smallest continuation stage, relative to the full mismatch
 STAGE_ITERATIONS = 4  # Newton iterations per stage, in units of newton_max_iterations
 REGULARISATION_START = 1e3  # v_reg of the first solve of a saturating law, in units of the scene's
+COARSENING = 4  # element ratio of successive grids of the sequence
+COARSEST = 4  # largest grid solved from rest, in units of the scene's default elements
 
 
 @register
 class SteadyScheme(NewtonScheme):
-    """Newton on the steady equations with continuation in v - c; no time stepping."""
+    """Newton on the steady equations: from rest with continuation in v - c on coarse
+    grids, from the next coarser grid's steady state on fine ones; no time stepping."""
 
     name = "steady"
     transient = False
     time_accurate = False
+
+    def __init__(self, disc):
+        super().__init__(disc)
+        self.grid_iterations: list[int] = []  # Newton iterations on each grid, coarsest first
+
+    def statistics(self) -> dict:
+        return {**super().statistics(), "grid_iterations": list(self.grid_iterations)}
 
     def _stage(self, state, s, settings):
         d = self.disc
@@ -42,14 +66,55 @@ class SteadyScheme(NewtonScheme):
         self._stage(trial, 0.0, NewtonSettings(1.0, 0))
         self.work.stats[:] = 0
 
+    @property
+    def _stage_settings(self) -> NewtonSettings:
+        return self.settings._replace(
+            max_iterations=STAGE_ITERATIONS * self.settings.max_iterations)
+
     def solve(self, state) -> None:
+        """The steady state, in place: from rest on a grid up to COARSEST times the
+        default elements, else from the steady state of a grid COARSENING times
+        coarser, interpolated (:func:`coarsened`, :func:`interpolate`). The stages of
+        continuation of every grid are counted as steps, their Newton iterations with
+        this scheme's (and each grid's apart, ``grid_iterations``).
+
+        Raises NumericalError when a stage from rest falls below MIN_STAGE of the
+        mismatch, or Newton does not converge from a coarser grid's steady state (on
+        grids so fine that its update stalls above its round-off floor).
+        """
+        d = self.disc
+        if d.grid.n_elements <= COARSEST * default_elements(d.params):
+            self._solve_from_rest(state)
+            self.grid_iterations = [int(self.work.stats[0]["newton_iterations"])]
+            return
+        coarse = copy.copy(d)
+        coarse.grid, index = coarsened(d.grid, COARSENING)
+        coarse.mesh = mesh_of(coarse.grid)
+        coarse.loads = Loads(*(q if q.ndim == 1 else q[:, index] for q in d.loads))
+        level = SteadyScheme(coarse)
+        coarse_state = coarse.new_state()
+        level.solve(coarse_state)
+        self.steps += level.steps
+        stats, level_stats = self.work.stats[0], level.work.stats[0]
+        for key in ("newton_iterations", "line_search_cuts"):
+            stats[key] += level_stats[key]
+        before = int(stats["newton_iterations"])
+        interpolate(coarse.grid, coarse_state, d.grid, state)
+        if not self._stage(state, 1.0, self._stage_settings):
+            raise NumericalError(
+                f"steady Newton iteration on {d.grid.n_elements} elements did not converge "
+                f"from the steady state of {coarse.grid.n_elements} elements (residual "
+                f"norm {stats['merit']:.3g})",
+                kind=FailureKind.CONTINUATION, t=0.0, quantity="newton")
+        self.grid_iterations = [*level.grid_iterations,
+                                int(stats["newton_iterations"]) - before]
+
+    def _solve_from_rest(self, state) -> None:
         """Continuation in v - c (after one in v_reg for a saturating law); the number of
         stages is counted as steps. An exact law first solves its regularised twin
         (physics.model.regularised) so, and then itself from there at full speed: the
         semi-smooth Newton cycles from rest, where every node's stick/slip state is
         wrong, and converges from the twin's (a few iterations).
-
-        Raises NumericalError when the stage falls below MIN_STAGE of the mismatch.
         """
         model = self.disc.model
         exact = is_exact(model.law)
@@ -65,16 +130,14 @@ class SteadyScheme(NewtonScheme):
             self.disc.model = model
         if exact:
             self.steps += 1
-            if not self._stage(state, 1.0, self.settings._replace(
-                    max_iterations=STAGE_ITERATIONS * self.settings.max_iterations)):
+            if not self._stage(state, 1.0, self._stage_settings):
                 raise NumericalError(
                     "steady semi-smooth Newton iteration of the exact friction law did not "
                     "converge from its regularised twin's steady state",
                     kind=FailureKind.CONTINUATION, t=0.0, quantity="newton")
 
     def _continue_in_speed(self, state) -> None:
-        stage_settings = self.settings._replace(
-            max_iterations=STAGE_ITERATIONS * self.settings.max_iterations)
+        stage_settings = self._stage_settings
         s_done, ds = 0.0, 1.0
         while s_done < 1.0:
             s = min(1.0, s_done + ds)
@@ -91,3 +154,32 @@ class SteadyScheme(NewtonScheme):
                         f"steady Newton iteration failed at {100 * s_done:.4g}% of the "
                         f"speed mismatch (continuation step below {MIN_STAGE:g})",
                         kind=FailureKind.CONTINUATION, t=0.0, quantity="newton")
+
+
+def coarsened(grid: Grid, factor: int) -> tuple[Grid, np.ndarray]:
+    """A grid of about 1/factor of ``grid``'s elements, on a subset of its nodes, and the
+    indices of that subset.
+
+    Each segment between 0, x1, x2 and L keeps about every factor-th of its nodes
+    (evenly spaced in index, so the coarse grid is graded as the fine one), its ends
+    among them, and at least two elements (all it has, if fewer).
+    """
+    ends = (0, grid.j1, grid.j2, grid.n_elements)
+    parts = []
+    for a, b in zip(ends[:-1], ends[1:]):
+        k = min(b - a, max(2, round((b - a) / factor)))
+        parts.append(np.rint(np.linspace(a, b, k + 1)).astype(np.int64)[:-1])
+    index = np.concatenate([*parts, [grid.n_elements]])
+    j1, j2 = np.searchsorted(index, [grid.j1, grid.j2])
+    return Grid(grid.x[index], int(j1), int(j2)), index
+
+
+def interpolate(coarse: Grid, state, fine: Grid, out) -> None:
+    """A coarse grid's steady state on a finer grid, as Newton's start: u, theta and the
+    friction ratios (on the contact nodes of each) linear in x; the rates zero, the
+    friction forces left to Newton's first assembly."""
+    out.assign(type(out).zeros(fine.n_elements + 1))
+    out.u[:] = np.interp(fine.x, coarse.x, state.u)
+    out.theta[:] = np.interp(fine.x, coarse.x, state.theta)
+    cc, cf = slice(coarse.j1, coarse.j2 + 1), slice(fine.j1, fine.j2 + 1)
+    out.lam[cf] = np.interp(fine.x[cf], coarse.x[cc], state.lam[cc])
