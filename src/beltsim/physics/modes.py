@@ -193,7 +193,8 @@ def exact_spectrum(scene, f_max: float, damping: float | None = None,
     for lam in seeds:
         root = ch.root(complex(lam))
         if (root is not None and 0.0 <= root.imag <= 2.0 * math.pi * f_max
-                and abs(root) >= continuum.NEUTRAL and all(abs(root - o) > 1e-7 * abs(root) for o in found)):
+                and abs(root) >= continuum.NEUTRAL
+                and all(abs(root - o) > 1e-7 * abs(root) for o in found)):
             found.append(root)
     return np.array(sorted(found, key=lambda z: -z.real))
 

@@ -142,7 +142,7 @@ def forces(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, loads=None, rati
     u, th, ud, td: the nodal fields and their local rates (N + 1, boundary zeros).
     """
     B, A, b2 = p.B, p.A, p.shear
-    rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
+    rho, I, hh = p.mass, p.rotary_inertia, p.half_height
     he, hb = mesh.he, mesh.hb
     F, _ = friction(slip_velocity(u, th, ud, td, t, mesh, p, drive), t, mesh, p, drive,
                     ratios)
@@ -259,7 +259,7 @@ def power_terms(state: State, t, mesh: Mesh, p: ModelParams, drive, loads=None):
     """The power terms of POWER_TERMS (W) of a state at t, as
     :func:`beltsim.physics.model.power_terms` gives them."""
     u, th, ud, td, F = state.u, state.theta, state.ud, state.td, state.fnode
-    c, hh, he, hb = p.speed, p.half_height, mesh.he, mesh.hb
+    c, hh, hb = p.speed, p.half_height, mesh.hb
     j = contact_nodes(mesh)
     target = mismatch(drive, t)
     strain_b = strain(u + hh * th, mesh.sw, j)
