@@ -42,6 +42,8 @@ DEFAULT_OUT = ROOT / "docs" / "performance"
 SCENE = "paper_slip"
 #: (grid or None for the default, repeats, transient peers' wall cap in s, grid ladder)
 MODES = {False: (None, 3, 600.0, (250, 600, 1000, 2000)), True: (40, 1, 60.0, (20, 40, 60))}
+#: the steady scheme's grids: the cost of a solve against the grid
+STEADY_LADDER = {False: (1000, 10000, 100000), True: (1000, 4000)}
 #: the closed drive's bench (benchmarks.drive), by mode: its options
 DRIVE_ARGS = {False: ["--peer-cap", "200"],
               True: ["--elements", "40", "--repeat", "1", "--grids", "3",
@@ -218,9 +220,47 @@ def build(page: Page, quick: bool, cold: bool = True) -> None:
         page.para(f"The default run on {res['elements']} elements is timed {len(same)} times "
                   f"on this page, once by each command: {min(same):.3g} to {max(same):.3g} "
                   f"s. Their spread is the machine's, not beltsim's.")
+    _steady_section(page, quick, repeat)
     _drive_section(page, quick, cold)
     page.para(f"Load average at the end of the run: {os.getloadavg()[0]:.2f} (at the start: "
               f"see the top of the page); on this machine {os.cpu_count()} cores.")
+
+
+def _steady_section(page: Page, quick: bool, repeat: int) -> None:
+    from beltsim.problem.scene import shipped_scene
+    from beltsim.simulation.controller import run
+    from beltsim.simulation.result import reference_of
+    from beltsim.simulation.solution import relative_error
+
+    ladder = STEADY_LADDER[quick]
+    page.heading("The steady scheme against the grid")
+    page.para(
+        f"`beltsim run {SCENE} --set numerics.integrator=steady --set numerics.elements=N"
+        f" [--set numerics.friction_law=exact]`, the shortest of {repeat}: grids finer than "
+        "four times the default start from the steady state of a grid four times coarser "
+        "(grid sequencing), so the continuation stages stay at the coarsest grid's and "
+        "Newton takes a few iterations on each finer one (per grid, coarsest first). "
+        "Error: the total friction against the exact solution.")
+    rows = []
+    for law in ("tanh", "exact"):
+        for n in ladder:
+            over = [("numerics.integrator", "steady"), ("numerics.elements", n)]
+            if law == "exact":
+                over.append(("numerics.friction_law", "exact"))
+            scene = shipped_scene(SCENE, over)
+            res = min((run(scene, raise_on_failure=False) for _ in range(repeat)),
+                      key=lambda r: r.wall_time)
+            if not res.converged:
+                page.fail(f"steady, {law}, {n} elements: {res.reason}")
+                rows.append([law, str(n), "**failed**", "", "", ""])
+                continue
+            err = relative_error(res.solution.total_friction,
+                                 reference_of(scene).total_friction)
+            its = res.statistics.get("grid_iterations", [])
+            rows.append([law, str(n), fmt(res.wall_time, ".3g"), str(res.steps),
+                         " + ".join(map(str, its)), f"{err:.2e}"])
+    page.table(["friction law", "elements", "wall [s]", "continuation stages",
+                "Newton iterations per grid", "total friction error"], rows)
 
 
 def run_drive_bench(args) -> dict:
