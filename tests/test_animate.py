@@ -54,7 +54,7 @@ def test_every_frame_names_the_scheme_and_the_damping():
     from beltsim.plots.animate import scheme_label
     from beltsim.problem.scene import load_scene
     default = scheme_label(load_scene(scene_path("paper_slip")))
-    assert default == "implicit (time-accurate), damping 39 1/s"
+    assert default == "esdirk3 (time-accurate), damping 39 1/s"
     pseudo = scheme_label(load_scene(scene_path("paper_slip"), ["numerics.integrator=pseudo"]))
     assert pseudo.startswith("pseudo (pseudo-transient path)") and "acceleration" in pseudo
 

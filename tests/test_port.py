@@ -18,7 +18,8 @@ pytestmark = pytest.mark.lab
 
 
 def _runs(overrides, solver="splu"):
-    scene = load_scene(scene_path("paper_slip"), overrides)
+    # the port is of BDF2, "implicit" (the default scheme is esdirk3)
+    scene = load_scene(scene_path("paper_slip"), ["numerics.integrator=implicit", *overrides])
     return Simulation(scene).run(), port.port_simulation(scene, solver=solver).run()
 
 
@@ -49,7 +50,8 @@ def test_banded_port_takes_the_same_steps():
 
 
 def test_port_takes_the_same_steps_under_distributed_loads():
-    scene = load_scene(scene_path("paper_slip"), ["numerics.elements=40", "numerics.t_end=0.03"])
+    scene = load_scene(scene_path("paper_slip"), ["numerics.elements=40", "numerics.t_end=0.03",
+                                                  "numerics.integrator=implicit"])
     ours, theirs = Simulation(scene), port.port_simulation(scene)
     x = ours.grid.x
     shape = np.sin(np.pi * x / x[-1])

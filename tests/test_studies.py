@@ -34,11 +34,12 @@ def test_convergence_command_small_ladder(tmp_path):
                 str(tmp_path))
     assert proc.returncode == 0, proc.stderr
     table = read_csv_text(tmp_path / "convergence.csv")
-    assert [r["scheme"] for r in table] == (["explicit"] * 3 + ["implicit"] * 3
-                                             + ["pseudo"] * 3 + ["steady"] * 3
-                                             + ["richardson"] * 3)
+    schemes = [r["scheme"] for r in table]
+    assert schemes[-3:] == ["richardson"] * 3  # each registered scheme, then extrapolation
+    assert sorted(schemes[:-3]) == sorted(
+        [s for s in ("esdirk3", "explicit", "implicit", "pseudo", "steady") for _ in range(3)])
     assert all(float(r["converged"]) == 1.0 for r in table)  # booleans as numbers
-    for scheme in ("explicit", "implicit", "pseudo", "steady"):
+    for scheme in ("esdirk3", "explicit", "implicit", "pseudo", "steady"):
         errs = [float(r["error_total_friction"]) for r in table if r["scheme"] == scheme]
         assert errs[0] > errs[1] > errs[2]  # refining shrinks the error
         assert all(float(r["wall_time"]) > 0 for r in table if r["scheme"] == scheme)
@@ -135,14 +136,14 @@ def test_lab_bench_against_peers_and_port():
     assert last["peers"]["newton"]["converged"] is True and last["steady_speedup"] > 0
     # same grid, same discretisation, same steady criterion: the same steady state
     assert abs(last["ours_error"] - last["peer_error"]) < 1e-4
-    # the port of the default scheme: the same steps, Newton iterations and end time, and
-    # the same state (total friction: measured 9e-16 relative from ours; other
+    # the port of BDF2 against our BDF2 run: the same steps, Newton iterations and end
+    # time, and the same state (total friction: measured 9e-16 relative from ours; other
     # arithmetic in the linear solves, so a bound well above round-off)
     row = last["port"]
-    assert row["converged"] is True and row["steps"] == row["ours_steps"] == last["ours_steps"]
+    assert row["converged"] is True and row["steps"] == row["ours_steps"]
     assert row["newton_iterations"] == row["ours_newton_iterations"]
     assert row["simulated_time"] == row["ours_simulated_time"]
-    assert row["total_friction"] == pytest.approx(last["ours_total_friction"], rel=1e-10)
+    assert row["total_friction_vs_ours"] < 1e-10
 
 
 @pytest.mark.unit
