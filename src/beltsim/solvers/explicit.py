@@ -105,33 +105,28 @@ _1, _2 = np.uint64(1), np.uint64(2)
 TANH_SATURATED = 19.0
 
 
-@njit(cache=True, inline="always")
-def _law(code, s):
-    """friction.law, without its exp where tanh is saturated (exp would underflow, the
-    slow path of libm) and gives the same values."""
-    if code == TANH and abs(s) > TANH_SATURATED:
-        return math.copysign(1.0, s), 0.0
-    return law(code, s)
-
-
-# tanh(s) = s + s z P(z) / Q(z), z = s^2, for |s| < TANH_RATIONAL (Cephes' tanh: within
-# an ulp, where (1 - e) / (1 + e), e = exp(-2 |s|), cancels); Q is monic
+# tanh(s) = s + s z P(z) / Q(z), z = s^2, for |s| < TANH_RATIONAL (Cephes' tanh, within
+# an ulp; (1 - e) / (1 + e), e = exp(-2 |s|), cancels there: 5e-12 relative at s = 1e-4)
 TANH_RATIONAL = 0.625
 TANH_P = (-9.64399179425052238628e-1, -9.92877231001918586564e1, -1.61468768441708447952e3)
 TANH_Q = (1.12811678491632931402e2, 2.23548839060100448583e3, 4.84406305325125486048e3)
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always")
-def _warm_law(code, s):
-    """The smooth law and its slope at a warm start, without a call to libm near s = 0
-    (stick), where the Newton iteration from it runs most often."""
-    if code == TANH and abs(s) < TANH_RATIONAL:
-        z = s * s
-        num = (TANH_P[0] * z + TANH_P[1]) * z + TANH_P[2]
-        den = ((z + TANH_Q[0]) * z + TANH_Q[1]) * z + TANH_Q[2]
-        g = s + s * z * num / den
-        return g, 1.0 - g * g
-    return _law(code, s)
+@njit(cache=True, fastmath=SAFE_FASTMATH)
+def _law(code, s):
+    """friction.law, with tanh without a call to libm near s = 0 (stick, where the friction
+    solves run most) and where it is saturated (exp would underflow: libm's slow path;
+    1 and 0 are what it gives)."""
+    if code == TANH:
+        if abs(s) > TANH_SATURATED:
+            return math.copysign(1.0, s), 0.0
+        if abs(s) < TANH_RATIONAL:
+            z = s * s
+            num = (TANH_P[0] * z + TANH_P[1]) * z + TANH_P[2]
+            den = ((z + TANH_Q[0]) * z + TANH_Q[1]) * z + TANH_Q[2]
+            g = s + s * z * num / den
+            return g, 1.0 - g * g
+    return law(code, s)
 
 
 @njit(cache=True, inline="always")
@@ -155,22 +150,32 @@ def _closed_form(code, s_pred, kappa):
 def _friction_scalar(code, s_pred, kappa, s0):
     """Solve s + kappa g(s) = s_pred; returns (s, g(s)) (for an exact law, g(s) in its set).
 
-    g is odd, increasing and |g| <= 1 (unless linear), so the root lies in
-    [s_pred - kappa, s_pred + kappa]. Newton from s0 (the node's value at the previous
-    step, so one or two iterations in a settled state), safeguarded by bisection.
-    A sliding node's root lies at the edge of that interval, to round-off: s0 is
-    clamped into it, not replaced, and a converged step may end on the edge (strict
-    bounds sent a third of the steps of sliding nodes to bisection, 10-20 iterations).
+    The laws with a closed form by it, the smooth ones by _newton from s0.
     """
     if code != TANH and code != SQRT:
         return _closed_form(code, s_pred, kappa)
+    g0, gp0 = _law(code, s0)
+    return _newton(code, s_pred, kappa, s0, g0, gp0)
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH)
+def _newton(code, s_pred, kappa, s0, g0, gp0):
+    """Solve s + kappa g(s) = s_pred for a smooth law; g0, gp0: g, g' at s0.
+
+    g is odd, increasing and |g| <= 1, so the root lies in [s_pred - kappa, s_pred +
+    kappa]. Newton from s0 (the node's value at the previous step, so one or two
+    iterations in a settled state), safeguarded by bisection. A sliding node's root lies
+    at the edge of that interval, to round-off: s0 is clamped into it, not replaced, and
+    a converged step may end on the edge (strict bounds sent a third of the steps of
+    sliding nodes to bisection, 10-20 iterations).
+    """
     lo, hi = s_pred - kappa, s_pred + kappa
     s = min(max(s0, lo), hi)
+    g, gp = (g0, gp0) if s == s0 else _law(code, s)
     tol = 1e-13 * (abs(s_pred) + kappa)
     edge = 1e-15 * (abs(s_pred) + kappa)  # round-off of lo and hi
     last_step = hi - lo
     for _ in range(100):
-        g, gp = _law(code, s)
         r = s + kappa * g - s_pred
         ds = -r / (1.0 + kappa * gp)
         if abs(ds) <= SMALL_STEP * (1.0 + abs(s)) and lo - edge <= s + ds <= hi + edge:
@@ -190,7 +195,8 @@ def _friction_scalar(code, s_pred, kappa, s0):
             ds = 0.5 * (lo + hi) - s
         last_step = abs(ds)
         s += ds
-    return s, _law(code, s)[0]
+        g, gp = _law(code, s)
+    return s, g
 
 
 # columns of Coefficients.fr, the friction nodes' coefficients: a row per node, so the
@@ -260,7 +266,7 @@ def _warm_start(code, s, kappa):
     the first Newton iteration of _friction_scalar (written out), for the others the
     closed form in the warm start's regime (stick or slide, linear part or bound)."""
     if code == TANH or code == SQRT:
-        g, gp = _warm_law(code, s)
+        g, gp = _law(code, s)
     else:
         bound = 1.0 if code == RAMP else 0.0
         if code == LINEAR or (code == RAMP and abs(s) <= bound):
@@ -355,10 +361,13 @@ def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, work, target, ff, co, 
             # a saturated node whose bracket [sp - kap, sp + kap] is saturated on the
             # same side: the full solve's g is the predicted one, and the chain need
             # not wait for it
-            s, g = _friction_scalar(code, sp, kap, s0)
+            s, g = _newton(code, sp, kap, s0, work[j, W_G0], work[j, W_GP])
             d_next = d_pred
         else:
-            s, g = _friction_scalar(code, sp, kap, s0)
+            if code == TANH or code == SQRT:
+                s, g = _newton(code, sp, kap, s0, work[j, W_G0], work[j, W_GP])
+            else:
+                s, g = _closed_form(code, sp, kap)
             d_next = eb[j] + fr[j, FR_KB] * (-fhf * g)
         F = -fhf * g
         va[j] += fr[j, FR_FM] * F
