@@ -215,8 +215,8 @@ N_FR = 11
 class Coefficients(NamedTuple):
     """Per-node coefficients of one step (precomputed for a step size)."""
 
-    P: np.ndarray  # the velocity system solved: vm_j = P_j v_a,j + Ql_j vm_{j-1}
-    Ql: np.ndarray
+    P: np.ndarray  # the velocity system solved for 2 vm (times 2 is exact, and 2 vm - v_a
+    Ql: np.ndarray  # then a subtraction): 2 vm_j = P_j v_a,j + Ql_j 2 vm_{j-1}
     ar: np.ndarray  # dt B / (m_j h_j), dt B / (m_j h_{j-1}): the axial kick
     al: np.ndarray
     br: np.ndarray  # the same for the bending term
@@ -239,7 +239,7 @@ def coefficients(dt, mesh, p):
         # G v_j = g_j (v_j - v_{j-1}), g_j = 2 c / h_{j-1}
         g = 2.0 * c / he[j - 1]
         piv = 2.0 / dt + p.damping + g
-        co.P[j] = (2.0 / dt) / piv
+        co.P[j] = 2.0 * ((2.0 / dt) / piv)
         co.Ql[j] = g / piv
         co.ar[j] = dt * p.B / (m * he[j])
         co.al[j] = dt * p.B / (m * he[j - 1])
@@ -421,12 +421,13 @@ def _drift_and_kick(u, th, va, wa, bb, eb, ud, td, last, co, dt, spring, hh):
     """
     P, Ql, ar, al, br, bl = co.P, co.Ql, co.ar, co.al, co.br, co.bl
     n = np.uint64(u.shape[0])
-    mv = P[1] * va[1]  # node 1
+    hdt = 0.5 * dt
+    mv = P[1] * va[1]  # node 1: twice the midpoint velocities
     mw = P[1] * wa[1]
-    u_l, u_k = u[0], u[1] + dt * mv  # nodes k - 1, k = j - 1 (drifted)
-    t_l, t_k = th[0], th[1] + dt * mw
-    v_k = 2.0 * mv - va[1]  # node k's velocities after the drift
-    w_k = 2.0 * mw - wa[1]
+    u_l, u_k = u[0], u[1] + hdt * mv  # nodes k - 1, k = j - 1 (drifted)
+    t_l, t_k = th[0], th[1] + hdt * mw
+    v_k = mv - va[1]  # node k's velocities after the drift
+    w_k = mw - wa[1]
     u[1] = u_k
     th[1] = t_k
     for j in range(_2, n):
@@ -434,10 +435,10 @@ def _drift_and_kick(u, th, va, wa, bb, eb, ud, td, last, co, dt, spring, hh):
         # the chain's product first: the compiler fuses the first into a multiply-add
         mv = Ql[j] * mv + P[j] * va[j]
         mw = Ql[j] * mw + P[j] * wa[j]
-        u_j = u[j] + dt * mv
-        t_j = th[j] + dt * mw
-        v_j = 2.0 * mv - va[j]
-        w_j = 2.0 * mw - wa[j]
+        u_j = u[j] + hdt * mv
+        t_j = th[j] + hdt * mw
+        v_j = mv - va[j]
+        w_j = mw - wa[j]
         u[j] = u_j
         th[j] = t_j
         eu = ar[k] * (u_j - u_k) - al[k] * (u_k - u_l)
