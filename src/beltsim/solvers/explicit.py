@@ -106,7 +106,7 @@ TANH_SATURATED = 19.0
 
 
 # tanh(s) = s + s z P(z) / Q(z), z = s^2, for |s| < TANH_RATIONAL (Cephes' tanh, within
-# an ulp; (1 - e) / (1 + e), e = exp(-2 |s|), cancels there: 5e-12 relative at s = 1e-4)
+# an ulp; (1 - e) / (1 + e), e = exp(-2 |s|), cancels there: 3e-13 relative at s = 1e-4)
 TANH_RATIONAL = 0.625
 TANH_P = (-9.64399179425052238628e-1, -9.92877231001918586564e1, -1.61468768441708447952e3)
 TANH_Q = (1.12811678491632931402e2, 2.23548839060100448583e3, 4.84406305325125486048e3)
@@ -283,8 +283,8 @@ def _warm_start(code, s, kappa):
 def _predicted(code, s_pred, kappa, s0, g0, gp, inv):
     """(ok, s, g): the root of s + kappa g(s) = s_pred if the warm start's prediction
     (_warm_start) holds, else ok is False. For a smooth law: the first Newton iteration
-    from s0 when it converges (~95% of the node-steps), for the others: the closed form
-    when the node stays in its regime."""
+    from s0 when it converges (most node-steps), for the others: the closed form when
+    the node stays in its regime."""
     if code == TANH or code == SQRT:
         ds = (s_pred - s0 - kappa * g0) * inv
         edge = 1e-15 * (abs(s_pred) + kappa)  # round-off of the bracket's ends
@@ -324,9 +324,10 @@ def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, work, target, ff, co, 
     of node j. Node j's response predicted from its warm start (_warm_start) is affine
     in that slip velocity, so the chain carries d_j = D0 - D1 d_{j-2} - D2 d_{j-1}, two
     multiply-adds, while the check of the prediction (_predicted) and the full solve where
-    it fails (_friction_scalar) run beside it. What does not depend on the chain (the
-    estimate, the law at the warm start, D0..D2) is computed first, in a pass without
-    a chain, so that its latency (two divisions) does not hold the sweep.
+    it fails (_newton, _closed_form: _friction_scalar's) run beside it. What does not
+    depend on the chain (the estimate, the law at the warm start, D0..D2) is computed
+    first, in a pass without a chain, so that its latency (two divisions) does not hold
+    the sweep.
     """
     c0, j2, hh, code = np.uint64(mesh.c0), np.uint64(mesh.j2), p.half_height, p.law
     inv_reg = 1.0 / p.regularisation
@@ -335,8 +336,9 @@ def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, work, target, ff, co, 
     b_l1 = u[c0 - _1] + hh * th[c0 - _1]
     for j in range(c0, j2 + _1):
         b_j = u[j] + hh * th[j]
-        work[j, W_EST] = bb[j] + (fr[j, FR_EST] * eb[j] - C_EST * db[j] + fr[j, FR_T0] * b_l2
-                            + fr[j, FR_T1] * b_l1 + fr[j, FR_T2] * b_j - target)
+        work[j, W_EST] = bb[j] + (fr[j, FR_EST] * eb[j] - C_EST * db[j]
+                                  + fr[j, FR_T0] * b_l2 + fr[j, FR_T1] * b_l1
+                                  + fr[j, FR_T2] * b_j - target)
         g0, gp, inv, gc, gs = _warm_start(code, sfr[j], fr[j, FR_KAP] * ff)
         kf = fr[j, FR_KB] * fr[j, FR_FH] * ff
         slope = kf * gs * inv_reg  # d_j's derivative in the estimate
@@ -432,7 +434,8 @@ def _drift_and_kick(u, th, va, wa, bb, eb, ud, td, last, co, dt, spring, hh):
     th[1] = t_k
     for j in range(_2, n):
         k = j - _1
-        # the chain's product first: the compiler fuses the first into a multiply-add
+        # the chain's product first: the compiler fuses a sum's first product into the
+        # multiply-add, so the chain from node to node is that one operation
         mv = Ql[j] * mv + P[j] * va[j]
         mw = Ql[j] * mw + P[j] * wa[j]
         u_j = u[j] + hdt * mv
