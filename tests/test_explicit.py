@@ -20,6 +20,7 @@ from beltsim.solvers.explicit import (
     EXPLICIT_SAFETY,
     History,
     _friction_scalar,
+    _law,
     advance_explicit,
     explicit_amplification,
     explicit_stable_dt,
@@ -292,3 +293,19 @@ def test_friction_scalar_solves_its_equation(code):
         gs = law_numpy(code, s)[0]
         assert g == pytest.approx(gs, abs=1e-9)
         assert s + kappa * gs == pytest.approx(s_pred, abs=1e-9 * (abs(s_pred) + kappa))
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize("code", [0, 1, 2, 3])
+def test_kernel_law_is_the_friction_law(code):
+    """The kernel's law (tanh by a rational near 0 and 1 where saturated, without libm)
+    against numpy's (tanh within half an ulp): 2 ulps, the rational's ulp and numpy's;
+    the slope 1 - g^2 then within 2 * 2 ulps absolute. Saturated tanh exactly +-1, 0."""
+    s = np.concatenate([np.logspace(-12, 2, 801), -np.logspace(-12, 2, 801), [0.0]])
+    got = np.array([_law(code, x) for x in s])
+    g, gp = law_numpy(code, s)
+    np.testing.assert_allclose(got[:, 0], g, rtol=4.5e-16, atol=0.0)
+    np.testing.assert_allclose(got[:, 1], gp, rtol=0.0, atol=9e-16)
+    if code == 1:
+        far = np.abs(s) > 19.0
+        assert np.array_equal(got[far, 0], np.sign(s[far])) and not got[far, 1].any()

@@ -97,38 +97,85 @@ class History(NamedTuple):
         return cls(*(np.zeros(n_nodes) for _ in cls._fields))
 
 
-@njit(cache=True)
-def _friction_scalar(code, s_pred, kappa, s0):
-    """Solve s + kappa g(s) = s_pred; returns (s, g(s)) (for an exact law, g(s) in its set).
+# numba tests a signed index for a negative value (and wraps it) at every access, a
+# branch and a select that cost more than the arithmetic in the sweeps below: their
+# indices are unsigned
+_1, _2 = np.uint64(1), np.uint64(2)
+# |s| beyond which tanh(s) rounds to +-1 and its slope to 0 (exp(-2 s) < 2^-54)
+TANH_SATURATED = 19.0
 
-    g is odd, increasing and |g| <= 1 (unless linear), so the root lies in
-    [s_pred - kappa, s_pred + kappa]. Newton from s0 (the node's value at the previous
-    step, so one or two iterations in a settled state), safeguarded by bisection.
-    A sliding node's root lies at the edge of that interval, to round-off: s0 is
-    clamped into it, not replaced, and a converged step may end on the edge (strict
-    bounds sent a third of the steps of sliding nodes to bisection, 10-20 iterations).
-    """
-    if code == LINEAR:  # closed form
+
+# tanh(s) = s + s z P(z) / Q(z), z = s^2, for |s| < TANH_RATIONAL (Cephes' tanh, within
+# an ulp; (1 - e) / (1 + e), e = exp(-2 |s|), cancels there: 3e-13 relative at s = 1e-4)
+TANH_RATIONAL = 0.625
+TANH_P = (-9.64399179425052238628e-1, -9.92877231001918586564e1, -1.61468768441708447952e3)
+TANH_Q = (1.12811678491632931402e2, 2.23548839060100448583e3, 4.84406305325125486048e3)
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH)
+def _law(code, s):
+    """friction.law, with tanh without a call to libm near s = 0 (stick, where the friction
+    solves run most) and where it is saturated (exp would underflow: libm's slow path;
+    1 and 0 are what it gives)."""
+    if code == TANH:
+        if abs(s) > TANH_SATURATED:
+            return math.copysign(1.0, s), 0.0
+        if abs(s) < TANH_RATIONAL:
+            z = s * s
+            num = (TANH_P[0] * z + TANH_P[1]) * z + TANH_P[2]
+            den = ((z + TANH_Q[0]) * z + TANH_Q[1]) * z + TANH_Q[2]
+            g = s + s * z * num / den
+            return g, 1.0 - g * g
+    return law(code, s)
+
+
+@njit(cache=True, inline="always")
+def _closed_form(code, s_pred, kappa):
+    """Solve s + kappa g(s) = s_pred for the laws with a closed form (linear, exact,
+    ramp); returns (s, g(s)) (for an exact law, g(s) in its set)."""
+    if code == LINEAR:
         s = s_pred / (1.0 + kappa)
         return s, s
     # the exact laws, by projection: the node sticks (s = 0) if its ratio s_pred / kappa
     # can hold it (always for adhesion), else slides with the ratio on the bound
     if code == ADHESION or (code == EXACT and abs(s_pred) <= kappa):
         return 0.0, s_pred / kappa
-    if code == EXACT:
-        return (s_pred - kappa, 1.0) if s_pred > 0 else (s_pred + kappa, -1.0)
-    if code == RAMP:
-        if abs(s_pred) <= 1.0 + kappa:
-            s = s_pred / (1.0 + kappa)
-            return s, s
-        return (s_pred - kappa, 1.0) if s_pred > 0 else (s_pred + kappa, -1.0)
+    if code == RAMP and abs(s_pred) <= 1.0 + kappa:
+        s = s_pred / (1.0 + kappa)
+        return s, s
+    return (s_pred - kappa, 1.0) if s_pred > 0 else (s_pred + kappa, -1.0)
+
+
+@njit(cache=True)
+def _friction_scalar(code, s_pred, kappa, s0):
+    """Solve s + kappa g(s) = s_pred; returns (s, g(s)) (for an exact law, g(s) in its set).
+
+    The laws with a closed form by it, the smooth ones by _newton from s0.
+    """
+    if code != TANH and code != SQRT:
+        return _closed_form(code, s_pred, kappa)
+    g0, gp0 = _law(code, s0)
+    return _newton(code, s_pred, kappa, s0, g0, gp0)
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH)
+def _newton(code, s_pred, kappa, s0, g0, gp0):
+    """Solve s + kappa g(s) = s_pred for a smooth law; g0, gp0: g, g' at s0.
+
+    g is odd, increasing and |g| <= 1, so the root lies in [s_pred - kappa, s_pred +
+    kappa]. Newton from s0 (the node's value at the previous step, so one or two
+    iterations in a settled state), safeguarded by bisection. A sliding node's root lies
+    at the edge of that interval, to round-off: s0 is clamped into it, not replaced, and
+    a converged step may end on the edge (strict bounds sent a third of the steps of
+    sliding nodes to bisection, 10-20 iterations).
+    """
     lo, hi = s_pred - kappa, s_pred + kappa
     s = min(max(s0, lo), hi)
+    g, gp = (g0, gp0) if s == s0 else _law(code, s)
     tol = 1e-13 * (abs(s_pred) + kappa)
     edge = 1e-15 * (abs(s_pred) + kappa)  # round-off of lo and hi
     last_step = hi - lo
     for _ in range(100):
-        g, gp = law(code, s)
         r = s + kappa * g - s_pred
         ds = -r / (1.0 + kappa * gp)
         if abs(ds) <= SMALL_STEP * (1.0 + abs(s)) and lo - edge <= s + ds <= hi + edge:
@@ -148,29 +195,33 @@ def _friction_scalar(code, s_pred, kappa, s0):
             ds = 0.5 * (lo + hi) - s
         last_step = abs(ds)
         s += ds
-    return s, law(code, s)[0]
+        g, gp = _law(code, s)
+    return s, g
+
+
+# columns of Coefficients.fr, the friction nodes' coefficients: a row per node, so the
+# sweep reads them from one pointer (as 11 arrays their pointers spilled to the stack)
+FR_EST = 0  # A_EST + ALPHA dt c sw[j, 2]: this kick's increment at j in the estimate
+FR_T0, FR_T1, FR_T2 = 1, 2, 3  # c sw[j, 0..2], the transport c d/dx u_b at node j from
+# u_b at j-2, j-1, j (mesh.sw, physics.model.contact_stencil)
+FR_A0, FR_A1 = 4, 5  # ALPHA dt c sw[j, 0..1]: the transport of the increments at j-2, j-1
+FR_FH = 6  # wf_j f_s: the node's friction weight times the friction scale
+FR_FM, FR_FI = 7, 8  # dt / m_j, dt (h/2) / m_I,j: a nodal force's kick
+FR_KB = 9  # FR_FM + (h/2) FR_FI: the bottom-fibre kick of a unit force
+FR_KAP = 10  # FR_EST FR_KB FR_FH / v_reg: the scalar friction equation's kappa
+N_FR = 11
 
 
 class Coefficients(NamedTuple):
     """Per-node coefficients of one step (precomputed for a step size)."""
 
-    P: np.ndarray  # the velocity system solved: vm_j = P_j v_a,j + Ql_j vm_{j-1}
-    Ql: np.ndarray
+    P: np.ndarray  # the velocity system solved for 2 vm (times 2 is exact, and 2 vm - v_a
+    Ql: np.ndarray  # then a subtraction): 2 vm_j = P_j v_a,j + Ql_j 2 vm_{j-1}
     ar: np.ndarray  # dt B / (m_j h_j), dt B / (m_j h_{j-1}): the axial kick
     al: np.ndarray
     br: np.ndarray  # the same for the bending term
     bl: np.ndarray
-    fm: np.ndarray  # contact nodes: dt / m_j, dt (h/2) / m_I,j: a nodal force's kick
-    fi: np.ndarray
-    kb: np.ndarray  # fm + (h/2) fi: the bottom-fibre kick of a unit force
-    t0: np.ndarray  # friction nodes: c sw[j, 0..2], the transport c d/dx u_b at node j
-    t1: np.ndarray  # from u_b at j-2, j-1, j (mesh.sw, physics.model.contact_stencil)
-    t2: np.ndarray
-    a0: np.ndarray  # ALPHA dt t0, ALPHA dt t1: the transport of the increments at j-2, j-1
-    a1: np.ndarray
-    tr: np.ndarray  # ALPHA dt t2: the same at node j itself
-    fh: np.ndarray  # wf_j f_s: the node's friction weight times the friction scale
-    kap: np.ndarray  # (A_EST + tr) kb fh / v_reg: the scalar friction equation's kappa
+    fr: np.ndarray  # (N + 1, N_FR): the friction nodes' coefficients, columns FR_*
 
 
 @njit(cache=True)
@@ -180,89 +231,153 @@ def coefficients(dt, mesh, p):
     he, hb, sw, wf = mesh.he, mesh.hb, mesh.sw, mesh.wf
     rho, rot, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
     z = np.zeros
-    co = Coefficients(z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1),
-                      z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1),
-                      z(N + 1), z(N + 1), z(N + 1))
+    co = Coefficients(z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1), z(N + 1),
+                      z((N + 1, N_FR)))
     for j in range(1, N):
         m, mi = rho * hb[j], rot * hb[j]
         # row j of (2/dt + d + G) vm = (2/dt) v_a over the lumped mass, with
         # G v_j = g_j (v_j - v_{j-1}), g_j = 2 c / h_{j-1}
         g = 2.0 * c / he[j - 1]
         piv = 2.0 / dt + p.damping + g
-        co.P[j] = (2.0 / dt) / piv
+        co.P[j] = 2.0 * ((2.0 / dt) / piv)
         co.Ql[j] = g / piv
         co.ar[j] = dt * p.B / (m * he[j])
         co.al[j] = dt * p.B / (m * he[j - 1])
         co.br[j] = dt * p.A / (mi * he[j])
         co.bl[j] = dt * p.A / (mi * he[j - 1])
-        co.fm[j] = dt / m
-        co.fi[j] = dt * hh / mi
-        co.kb[j] = co.fm[j] + hh * co.fi[j]
     for j in range(mesh.c0, mesh.j2 + 1):
-        co.t0[j], co.t1[j], co.t2[j] = c * sw[j, 0], c * sw[j, 1], c * sw[j, 2]
-        co.a0[j], co.a1[j] = ALPHA * dt * co.t0[j], ALPHA * dt * co.t1[j]
-        co.tr[j] = ALPHA * dt * co.t2[j]
-        co.fh[j] = wf[j] * p.friction_scale
-        co.kap[j] = (A_EST + co.tr[j]) * co.kb[j] * co.fh[j] / p.regularisation
+        f = co.fr[j]
+        m, mi = rho * hb[j], rot * hb[j]
+        f[FR_FM] = dt / m
+        f[FR_FI] = dt * hh / mi
+        f[FR_KB] = f[FR_FM] + hh * f[FR_FI]
+        f[FR_T0], f[FR_T1], f[FR_T2] = c * sw[j, 0], c * sw[j, 1], c * sw[j, 2]
+        f[FR_A0], f[FR_A1] = ALPHA * dt * f[FR_T0], ALPHA * dt * f[FR_T1]
+        f[FR_EST] = A_EST + ALPHA * dt * f[FR_T2]
+        f[FR_FH] = wf[j] * p.friction_scale
+        f[FR_KAP] = f[FR_EST] * f[FR_KB] * f[FR_FH] / p.regularisation
     return co
 
 
+@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always")
+def _warm_start(code, s, kappa):
+    """(g, g', 1 / (1 + kappa g'), gc, gs) at a node's warm start s: the law, its slope
+    and the response to s_pred predicted from it, g ~ gc + gs s_pred: for a smooth law
+    the first Newton iteration of _friction_scalar (written out), for the others the
+    closed form in the warm start's regime (stick or slide, linear part or bound)."""
+    if code == TANH or code == SQRT:
+        g, gp = _law(code, s)
+    else:
+        bound = 1.0 if code == RAMP else 0.0
+        if code == LINEAR or (code == RAMP and abs(s) <= bound):
+            return 0.0, 0.0, 0.0, 0.0, 1.0 / (1.0 + kappa)
+        if code == ADHESION or (code == EXACT and s == 0.0):
+            return 0.0, 0.0, 0.0, 0.0, 1.0 / kappa
+        return 0.0, 0.0, 0.0, math.copysign(1.0, s), 0.0
+    inv = 1.0 / (1.0 + kappa * gp)
+    gs = gp * inv
+    return g, gp, inv, g - gs * (s + kappa * g), gs
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always")
+def _predicted(code, s_pred, kappa, s0, g0, gp, inv):
+    """(ok, s, g): the root of s + kappa g(s) = s_pred if the warm start's prediction
+    (_warm_start) holds, else ok is False. For a smooth law: the first Newton iteration
+    from s0 when it converges (most node-steps), for the others: the closed form when
+    the node stays in its regime."""
+    if code == TANH or code == SQRT:
+        ds = (s_pred - s0 - kappa * g0) * inv
+        edge = 1e-15 * (abs(s_pred) + kappa)  # round-off of the bracket's ends
+        if (abs(s0 - s_pred) <= kappa and abs(ds) <= SMALL_STEP * (1.0 + abs(s0))
+                and abs(s0 + ds - s_pred) <= kappa + edge):
+            ds = min(max(s0 + ds, s_pred - kappa), s_pred + kappa) - s0
+            return True, s0 + ds, g0 + gp * ds
+        return False, 0.0, 0.0
+    s, g = _closed_form(code, s_pred, kappa)
+    if code == LINEAR or code == ADHESION:
+        return True, s, g
+    bound = 1.0 if code == RAMP else 0.0
+    same = (abs(s) <= bound) == (abs(s0) <= bound) and (abs(s) <= bound or s * s0 > 0.0)
+    return same, s, g
+
+
+# columns of the friction pass's work array (a row per node): what the sweep needs of
+# node j that does not depend on the nodes before it
+W_EST = 0  # the slip velocity's estimate but for this kick's increments at j-2 .. j
+W_D0, W_D1, W_D2 = 1, 2, 3  # the predicted increment d_j = D0 - D1 d_{j-2} - D2 d_{j-1}
+W_G0, W_GP, W_INV = 4, 5, 6  # the law at the warm start (_warm_start)
+N_W = 7
+
+
 @njit(cache=True, fastmath=SAFE_FASTMATH)
-def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target, ff, co, mesh, p):
+def _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, work, target, ff, co, mesh, p):
     """The kick's friction at the friction nodes c0..j2, in the direction of the flow.
 
     On entry va, wa hold the kick without friction, bb the bottom-fibre velocity
-    before the kick (overwritten) and eb its increment without friction; db the
-    previous kick's bottom increments, replaced by this kick's. ff: f*(t) / f* of the drive. The
+    before the kick and eb its increment without friction; db the previous kick's
+    bottom increments, replaced by this kick's. ff: f*(t) / f* of the drive. The
     transport reaches nodes j-2 and j-1 (mesh.sw): their increments of this kick are
-    known when node j is solved (upstream of c0, the kick without friction).
+    known when node j is solved (upstream of c0, the kick without friction). ``work``:
+    (N + 1, N_W) scratch.
+
+    The sweep's chain from node to node is the increment d_{j-1} in the slip velocity
+    of node j. Node j's response predicted from its warm start (_warm_start) is affine
+    in that slip velocity, so the chain carries d_j = D0 - D1 d_{j-2} - D2 d_{j-1}, two
+    multiply-adds, while the check of the prediction (_predicted) and the full solve where
+    it fails (_newton, _closed_form: _friction_scalar's) run beside it. What does not
+    depend on the chain (the estimate, the law at the warm start, D0..D2) is computed
+    first, in a pass without a chain, so that its latency (two divisions) does not hold
+    the sweep.
     """
-    c0, j2, hh, code, inv_reg = mesh.c0, mesh.j2, p.half_height, p.law, 1.0 / p.regularisation
-    smooth = code == TANH or code == SQRT
-    # the slip velocity's estimate but for this kick's friction, into bb (one pass
-    # without a chain from node to node)
-    for j in range(c0, j2 + 1):
-        bb[j] += ((A_EST + co.tr[j]) * eb[j] - C_EST * db[j]
-                  + co.t0[j] * (u[j - 2] + hh * th[j - 2])
-                  + co.t1[j] * (u[j - 1] + hh * th[j - 1])
-                  + co.t2[j] * (u[j] + hh * th[j]) - target)
-    d_l2 = eb[c0 - 2]  # nodes upstream of the friction nodes carry no friction
-    d_l1 = eb[c0 - 1]
-    for j in range(c0, j2 + 1):
-        known = bb[j] + co.a0[j] * d_l2 + co.a1[j] * d_l1
-        # the first Newton iteration of _friction_scalar, written out and evaluated
-        # at the warm start s0 before the slip velocity is known: the sweep's chain
-        # from node to node is then a few multiplications, while the law's exp and
-        # the divisions of successive nodes overlap. It converges in ~95% of the
-        # node-steps; the rest, and an s0 outside the bracket, go to the full solve.
-        s0, kap = sfr[j], co.kap[j] * ff
-        if code == TANH:
-            e = math.exp(-2.0 * abs(s0))
-            g0 = math.copysign((1.0 - e) / (1.0 + e), s0)
-            gp = 1.0 - g0 * g0
-        elif code == SQRT:
-            q = 1.0 / math.sqrt(1.0 + s0 * s0)
-            g0, gp = s0 * q, q * q * q
+    c0, j2, hh, code = np.uint64(mesh.c0), np.uint64(mesh.j2), p.half_height, p.law
+    inv_reg = 1.0 / p.regularisation
+    fr = co.fr
+    b_l2 = u[c0 - _2] + hh * th[c0 - _2]  # bottom-fibre displacements at j-2, j-1
+    b_l1 = u[c0 - _1] + hh * th[c0 - _1]
+    for j in range(c0, j2 + _1):
+        b_j = u[j] + hh * th[j]
+        work[j, W_EST] = bb[j] + (fr[j, FR_EST] * eb[j] - C_EST * db[j]
+                                  + fr[j, FR_T0] * b_l2 + fr[j, FR_T1] * b_l1
+                                  + fr[j, FR_T2] * b_j - target)
+        g0, gp, inv, gc, gs = _warm_start(code, sfr[j], fr[j, FR_KAP] * ff)
+        kf = fr[j, FR_KB] * fr[j, FR_FH] * ff
+        slope = kf * gs * inv_reg  # d_j's derivative in the estimate
+        work[j, W_D0] = (eb[j] - kf * gc) - slope * work[j, W_EST]
+        work[j, W_D1] = slope * fr[j, FR_A0]
+        work[j, W_D2] = slope * fr[j, FR_A1]
+        work[j, W_G0] = g0
+        work[j, W_GP] = gp
+        work[j, W_INV] = inv
+        b_l2, b_l1 = b_l1, b_j
+    d_l2 = eb[c0 - _2]  # nodes upstream of the friction nodes carry no friction
+    d_l1 = eb[c0 - _1]
+    for j in range(c0, j2 + _1):
+        s0, kap, fhf = sfr[j], fr[j, FR_KAP] * ff, fr[j, FR_FH] * ff
+        d_pred = (work[j, W_D0] - work[j, W_D1] * d_l2) - work[j, W_D2] * d_l1
+        sp = (work[j, W_EST] + fr[j, FR_A0] * d_l2 + fr[j, FR_A1] * d_l1) * inv_reg
+        ok, s, g = _predicted(code, sp, kap, s0, work[j, W_G0], work[j, W_GP], work[j, W_INV])
+        if ok:
+            d_next = d_pred
+        elif code == TANH and work[j, W_GP] == 0.0 and abs(sp) - kap > TANH_SATURATED and \
+                sp * s0 > 0.0:
+            # a saturated node whose bracket [sp - kap, sp + kap] is saturated on the
+            # same side: the full solve's g is the predicted one, and the chain need
+            # not wait for it
+            s, g = _newton(code, sp, kap, s0, work[j, W_G0], work[j, W_GP])
+            d_next = d_pred
         else:
-            g0, gp = 0.0, 0.0
-        inv = 1.0 / (1.0 + kap * gp)
-        sp = known * inv_reg
-        ds = (sp - s0 - kap * g0) * inv
-        edge = 1e-15 * (abs(sp) + kap)
-        if (smooth and abs(s0 - sp) <= kap and abs(ds) <= SMALL_STEP * (1.0 + abs(s0))
-                and abs(s0 + ds - sp) <= kap + edge):
-            ds = min(max(s0 + ds, sp - kap), sp + kap) - s0
-            s, g = s0 + ds, g0 + gp * ds
-        else:
-            s, g = _friction_scalar(code, sp, kap, s0)
-        F = -co.fh[j] * ff * g
-        va[j] += co.fm[j] * F
-        wa[j] += co.fi[j] * F
-        d = eb[j] + co.kb[j] * F
-        db[j] = d
-        d_l2, d_l1 = d_l1, d
+            if code == TANH or code == SQRT:
+                s, g = _newton(code, sp, kap, s0, work[j, W_G0], work[j, W_GP])
+            else:
+                s, g = _closed_form(code, sp, kap)
+            d_next = eb[j] + fr[j, FR_KB] * (-fhf * g)
+        F = -fhf * g
+        va[j] += fr[j, FR_FM] * F
+        wa[j] += fr[j, FR_FI] * F
+        db[j] = eb[j] + fr[j, FR_KB] * F
         sfr[j] = s
         fnode[j] = F
+        d_l2, d_l1 = d_l1, d_next
 
 
 @njit(cache=True, fastmath=SAFE_FASTMATH)
@@ -295,6 +410,55 @@ def _kick_from(u, th, va, wa, vb, wb, bb, eb, co, spring, hh):
 
 
 @njit(cache=True, fastmath=SAFE_FASTMATH)
+def _drift_and_kick(u, th, va, wa, bb, eb, ud, td, last, co, dt, spring, hh):
+    """The velocity terms with the drift, then the kick without friction and loads.
+
+    The velocity system is lower bidiagonal: one pass in the direction of the flow,
+    which kicks node j - 1 once its neighbours have drifted. The drifted u, theta and
+    the velocities of nodes j - 2 .. j stay in registers (stores to one array could
+    alias another for the compiler, which would reload them), so the pass's only chain
+    from node to node is the recurrence of each field's midpoint velocity. Node N passes
+    through with zero coefficients. With ``last``, ud, td receive the velocities before
+    the kick.
+    """
+    P, Ql, ar, al, br, bl = co.P, co.Ql, co.ar, co.al, co.br, co.bl
+    n = np.uint64(u.shape[0])
+    hdt = 0.5 * dt
+    mv = P[1] * va[1]  # node 1: twice the midpoint velocities
+    mw = P[1] * wa[1]
+    u_l, u_k = u[0], u[1] + hdt * mv  # nodes k - 1, k = j - 1 (drifted)
+    t_l, t_k = th[0], th[1] + hdt * mw
+    v_k = mv - va[1]  # node k's velocities after the drift
+    w_k = mw - wa[1]
+    u[1] = u_k
+    th[1] = t_k
+    for j in range(_2, n):
+        k = j - _1
+        # the chain's product first: the compiler fuses a sum's first product into the
+        # multiply-add, so the chain from node to node is that one operation
+        mv = Ql[j] * mv + P[j] * va[j]
+        mw = Ql[j] * mw + P[j] * wa[j]
+        u_j = u[j] + hdt * mv
+        t_j = th[j] + hdt * mw
+        v_j = mv - va[j]
+        w_j = mw - wa[j]
+        u[j] = u_j
+        th[j] = t_j
+        eu = ar[k] * (u_j - u_k) - al[k] * (u_k - u_l)
+        et = br[k] * (t_j - t_k) - bl[k] * (t_k - t_l) - spring * t_k
+        if last:
+            ud[k] = v_k
+            td[k] = w_k
+        bb[k] = v_k + hh * w_k
+        eb[k] = eu + hh * et
+        va[k] = v_k + eu
+        wa[k] = w_k + et
+        u_l, u_k, t_l, t_k, v_k, w_k = u_k, u_j, t_k, t_j, v_j, w_j
+    va[n - _1] = v_k
+    wa[n - _1] = w_k
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH)
 def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, drive, loads):
     """Steps from t until t >= t_stop (or max_steps). Returns (t, steps).
 
@@ -312,11 +476,11 @@ def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, driv
     hh = p.half_height
     spring = dt * p.shear / p.rotary_inertia
     co = coefficients(dt, mesh, p)
-    P, Ql, ar, al, br, bl = co.P, co.Ql, co.ar, co.al, co.br, co.bl
     bb = np.zeros(N + 1)
     eb = np.zeros(N + 1)
     yv = np.zeros(N + 1)  # a fresh start's velocities before the kick
     yw = np.zeros(N + 1)
+    work = np.zeros((N + 1, N_W))
     if fresh:
         for j in range(N + 1):
             fnode[j] = 0.0
@@ -326,7 +490,7 @@ def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, driv
             _kick_from(u, th, va, wa, yv if rep else ud, yw if rep else td, bb, eb, co,
                        spring, hh)
             _add_loads(va, wa, eb, t, dt, p, loads)
-            _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, target,
+            _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, work, target,
                            friction_factor(drive, t), co, mesh, p)
             for j in range(1, N):  # u_t - delta / 2
                 yv[j] = 1.5 * ud[j] - 0.5 * va[j]
@@ -337,38 +501,11 @@ def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, driv
     t_reached = t_stop - 1e-9 * dt
     while t < t_reached and steps < max_steps:
         last = t + dt >= t_reached or steps + 1 >= max_steps
-        # the velocity terms with the drift (the system is lower bidiagonal: one pass in
-        # the direction of the flow), and the kick of node j - 1 once its neighbours
-        # have drifted; node N passes through with zero coefficients, so the loop needs
-        # no branches (written out: a numba call here costs 10x the work)
-        mv = P[1] * va[1]
-        mw = P[1] * wa[1]
-        u[1] += dt * mv
-        th[1] += dt * mw
-        va[1] = 2.0 * mv - va[1]
-        wa[1] = 2.0 * mw - wa[1]
-        for j in range(2, N + 1):
-            mv = P[j] * va[j] + Ql[j] * mv
-            mw = P[j] * wa[j] + Ql[j] * mw
-            u[j] += dt * mv
-            th[j] += dt * mw
-            va[j] = 2.0 * mv - va[j]
-            wa[j] = 2.0 * mw - wa[j]
-            k = j - 1
-            eu = ar[k] * (u[k + 1] - u[k]) - al[k] * (u[k] - u[k - 1])
-            et = (br[k] * (th[k + 1] - th[k]) - bl[k] * (th[k] - th[k - 1])
-                  - spring * th[k])
-            if last:
-                ud[k] = va[k]
-                td[k] = wa[k]
-            bb[k] = va[k] + hh * wa[k]
-            eb[k] = eu + hh * et
-            va[k] += eu
-            wa[k] += et
+        _drift_and_kick(u, th, va, wa, bb, eb, ud, td, last, co, dt, spring, hh)
         t += dt
         steps += 1
         _add_loads(va, wa, eb, t, dt, p, loads)
-        _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, mismatch(drive, t),
+        _friction_pass(u, th, va, wa, bb, eb, db, sfr, fnode, work, mismatch(drive, t),
                        friction_factor(drive, t), co, mesh, p)
         if last:
             for j in range(1, N):
