@@ -117,7 +117,7 @@ class Characteristic:
                 _pair(P.A, -2.0 * P.I * P.c * lam, -(P.I * lt + P.b2)),
                 _pair(Ae, -2.0 * Ie * P.c * lam, -(Ie * lt + P.b2)))
 
-    def _fields(self, lam, zi, x, ks):
+    def _basis(self, lam, zi, x, ks):
         """(z, phi, z', phi') of each basis function of zone zi at x: (4, columns).
 
         Exponentials are scaled to be at most 1 on their zone (e^{s (x - a)} when Re s <= 0,
@@ -157,12 +157,12 @@ class Characteristic:
         Mt = np.zeros((self.n, self.n), complex)
         scale = 1.0 / (abs(lam) / P.c + 10.0)  # derivative rows to the size of the others
         last = len(self.zones) - 1
-        Mt[0:2, self.cols[0]] = self._fields(lam, 0, 0.0, ks)[:2]
-        Mt[2:4, self.cols[last]] = self._fields(lam, last, P.L, ks)[:2]
+        Mt[0:2, self.cols[0]] = self._basis(lam, 0, 0.0, ks)[:2]
+        Mt[2:4, self.cols[last]] = self._basis(lam, last, P.L, ks)[:2]
         row = 4
         for zi in range(last):
             x = self.zones[zi].b
-            left, right = self._fields(lam, zi, x, ks), self._fields(lam, zi + 1, x, ks)
+            left, right = self._basis(lam, zi, x, ks), self._basis(lam, zi + 1, x, ks)
             cl, cr = self.cols[zi], self.cols[zi + 1]
             Mt[row:row + 2, cl], Mt[row:row + 2, cr] = left[:2], -right[:2]
             row += 2
