@@ -79,9 +79,9 @@ def rule_text(rule, key="", registry=True) -> str:
 
 
 def _constants(*modules) -> dict:
-    """Names a default may quote as ``{NAME}``: the modules' numeric constants."""
+    """Names a default may quote as ``{NAME}``: the modules' numeric and string constants."""
     return {k: v for m in modules for k, v in vars(m).items() if k.isupper()
-            and isinstance(v, (int, float)) and not isinstance(v, bool)}
+            and isinstance(v, (int, float, str)) and not isinstance(v, bool)}
 
 
 CONSTANT = re.compile(r"\{([A-Z][A-Z0-9_]*)(?::([^}]*))?\}")
