@@ -145,7 +145,7 @@ def test_the_central_forms_path_converges_at_second_order_in_space():
     run on 2400 elements. Measured: 1.67e-3, 3.49e-4, 8.02e-5 on 300, 600, 1200 elements,
     orders 2.26 and 2.12 (the second lowered by the reference's own error, a quarter of
     the 1200 grid's at second order); required >= 1.8 for each halving. The ramp and the
-    slip start's path stay first order (a moving front; docs/theory/discretisation.md)."""
+    slip start's path stay first order with either form (the spectrum page)."""
     def history(n):
         res = beltsim.run(beltsim.load_scene(scene_path("paper_slip"), [
             f"numerics.elements={n}", "numerics.gyroscopic=central", "numerics.t_end=0.15",

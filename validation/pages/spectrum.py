@@ -200,10 +200,11 @@ def paths_section(page: Page, cfg: dict) -> dict:
         f"Read: after the ramp (t >= 0.1 s) the central form's path converges at orders "
         f"{orders('central', 2)} and the upwind form's at {orders('upwind', 2)}; during "
         f"the ramp they are {orders('central', 1)} and {orders('upwind', 1)}, and the slip "
-        f"start's path {orders('central', 3)} and {orders('upwind', 3)}: the slip front "
-        "moves through the grid, and the friction at a moving front is integrated over "
-        "whole control volumes (an O(h) error as the front crosses a node), whatever the "
-        "gyroscopic form.")
+        f"start's path {orders('central', 3)} and {orders('upwind', 3)}. That first-order "
+        "part does not depend on the gyroscopic form; its likely source, not isolated "
+        "here, is the slip front moving through the grid during the ramp: the friction "
+        "near a moving front is integrated over whole control volumes and read inside one "
+        "cell, so its error changes at O(h) as the front crosses a node.")
     return out
 
 
