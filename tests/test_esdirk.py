@@ -10,7 +10,6 @@ from test_mms import _scene as mms_scene
 import beltsim
 from beltsim import solvers
 from beltsim.errors import FailureKind
-from beltsim.io.results import write_checkpoint
 from beltsim.simulation.controller import Simulation
 from beltsim.solvers import esdirk
 from beltsim.studies.stability import DISCRETE_BOUNDS, Case, CellStatus, stability_cell
@@ -133,26 +132,6 @@ def test_same_steady_state_as_bdf2(law):
     assert (np.abs(rk.theta - bdf2.theta).max()
             < DISCRETE_BOUNDS["theta"] * np.abs(bdf2.theta).max())
 
-
-@pytest.mark.verification
-def test_resume_reaches_the_same_state_as_an_uninterrupted_run(tmp_path):
-    """The checkpoint holds what the next step needs (the accelerations of the first
-    stage, the friction predictor's history, the step): bit for bit."""
-    scene = beltsim.load_scene(scene_path("paper_slip"), [
-        "numerics.elements=200", "numerics.integrator=esdirk3",
-        "numerics.snapshot_interval=0.005"])
-    whole = Simulation(scene).run()
-    part = Simulation(scene)
-    chunks = []
-    first = part.run(callback=lambda sim: chunks.append(sim.t) or len(chunks) >= 9)
-    assert first.interrupted and not first.converged
-    write_checkpoint(tmp_path / "ck.npz", part)
-    rest = Simulation.resume(tmp_path / "ck.npz").run()
-    assert rest.converged and whole.converged
-    assert rest.steps == whole.steps and rest.simulated_time == whole.simulated_time
-    np.testing.assert_array_equal(rest.solution.u, whole.solution.u)
-    np.testing.assert_array_equal(rest.history["total_friction"],
-                                  whole.history["total_friction"])
 
 
 @pytest.mark.unit

@@ -25,7 +25,7 @@ def _scene(*overrides, name="paper_slip"):
 
 
 @pytest.mark.verification
-@pytest.mark.parametrize("integrator", ["implicit", "explicit"])
+@pytest.mark.parametrize("integrator", ["esdirk3", "implicit", "explicit"])
 def test_resume_reaches_the_same_state_as_an_uninterrupted_run(tmp_path, integrator):
     scene = _scene(f"numerics.integrator={integrator}", "numerics.snapshot_interval=0.005")
     whole = Simulation(scene).run()

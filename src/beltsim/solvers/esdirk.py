@@ -38,10 +38,17 @@ import numpy as np
 from numba import njit
 
 from ..physics.friction import EXACT, LINEAR, RAMP, law
-from ..physics.model import LAM_MAX, POWER_TERMS, assemble, bottom_strain, power_terms
+from ..physics.model import LAM_MAX, assemble, bottom_strain, power_terms
 from ..problem.drive import friction_factor, mismatch
-from .implicit import filtered_error, predict_friction
-from .newton import FAILED, NONFINITE, OK, NewtonScheme, newton
+from .implicit import (
+    AdaptiveScheme,
+    copy_state,
+    filtered_error,
+    landing_step,
+    predict_friction,
+    step_factor,
+)
+from .newton import FAILED, NONFINITE, OK, newton
 from .registry import register
 
 GAMMA = 1767732205903.0 / 4055673282236.0
@@ -59,10 +66,7 @@ TABLEAU_B = np.array([B1, B2, B3, B4])
 TABLEAU_B_HAT = np.array([E1, E2, E3, E4])
 TABLEAU_C = np.array([0.0, C2, C3, 1.0])
 
-SAFETY = 0.8
 MAX_GROWTH = 3.0  # a one-step method: no zero-stability bound on the step ratio
-MIN_SHRINK = 0.2
-NEWTON_CUT = 0.25  # step factor after a failed Newton solve
 
 
 class Rates(NamedTuple):
@@ -151,12 +155,10 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
         if remaining <= 1e-9 * h_next:  # round-off of the caller's times, not a step
             t = t_stop
             break
-        # steps that end on t_stop: the remaining span in equal parts of at most h_next
-        parts = math.ceil(remaining / min(h_next, h_max) * (1.0 - 1e-12))
-        h = remaining / parts
+        h, parts = landing_step(remaining, h_next, h_max)
         a0 = 1.0 / (GAMMA * h)
+        copy_state(u_n, th_n, ud_n, td_n, lam_n, u, th, ud, td, lam)
         for j in range(N + 1):
-            u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j] = u[j], th[j], ud[j], td[j], lam[j]
             vu[0, j], vt[0, j] = ud[j], td[j]
             au[0, j], at[0, j] = rates.au[j], rates.at[j]
         for k in range(power.shape[0]):
@@ -244,42 +246,29 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
             for k in range(power.shape[0]):
                 work[k] += h * (B1 * ps[0, k] + B2 * ps[1, k] + B3 * ps[2, k] + B4 * ps[3, k])
                 power[k] = ps[3, k]
-            factor = MAX_GROWTH if err == 0.0 else SAFETY * (tol / err) ** (1.0 / 3.0)
-            h_next = h * min(MAX_GROWTH, max(MIN_SHRINK, factor))
+            h_next = h * step_factor(err, tol, True, MAX_GROWTH)
             continue
         # rejected: back to t_n with a smaller step
         rejected += 1
         w.stats[0].failed_steps += 1
-        for j in range(N + 1):
-            u[j], th[j], ud[j], td[j], lam[j] = u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j]
-        if ok:
-            h_next = h * max(MIN_SHRINK, SAFETY * (tol / err) ** (1.0 / 3.0))
-        else:
-            h_next = h * NEWTON_CUT
+        copy_state(u, th, ud, td, lam, u_n, th_n, ud_n, td_n, lam_n)
+        h_next = h * step_factor(err, tol, ok, MAX_GROWTH)
         if h_next < h_min:
             return FAILED, t, h_prev, h_next, steps, rejected
     return OK, t, h_prev, h_next, steps, rejected
 
 
 @register
-class EsdirkScheme(NewtonScheme):
-    """ESDIRK3(2)4L[2]SA with local error control: third order, three Newton solves a step."""
+class EsdirkScheme(AdaptiveScheme):
+    """ESDIRK3(2)4L[2]SA with local error control: third order, three Newton solves a
+    step; the time-accurate default."""
 
     name = "esdirk3"
 
     def __init__(self, disc):
         super().__init__(disc)
-        n = disc.grid.n_elements + 1
-        self.rates = Rates.zeros(n)
+        self.rates = Rates.zeros(disc.grid.n_elements + 1)
         self.started = False  # whether rates.au, rates.at hold the state's accelerations
-        self.h_prev = 0.0  # no previous step: the friction predictor has no history
-        self.h_next = self.numerics.dt
-        self.power = np.zeros(len(POWER_TERMS))  # at the current time
-        self.work_done = np.zeros(len(POWER_TERMS))  # integrals since the start
-
-    @property
-    def dt(self) -> float:
-        return self.h_next
 
     def advance(self, state, t, t_stop, max_steps=10**9):
         d, num = self.disc, self.numerics
@@ -296,20 +285,12 @@ class EsdirkScheme(NewtonScheme):
         self.check_status(status, t, self.h_next)
         return t
 
-    def work_integrals(self) -> dict:
-        """The time integrals (J) of the power terms since the start of the run."""
-        return dict(zip(POWER_TERMS, (float(v) for v in self.work_done)))
-
     def checkpoint(self) -> dict:
-        return {**super().checkpoint(), "h": np.array([self.h_prev, self.h_next]),
-                "started": np.array(self.started), "power": self.power.copy(),
-                "work_done": self.work_done.copy(),
+        return {**super().checkpoint(), "started": np.array(self.started),
                 **{f"rates_{k}": a.copy() for k, a in zip(Rates._fields, self.rates)}}
 
     def restore(self, data: dict) -> None:
         super().restore(data)
-        self.h_prev, self.h_next = (float(v) for v in data["h"])
         self.started = bool(data["started"])
-        self.power[:], self.work_done[:] = data["power"], data["work_done"]
         for k, a in zip(Rates._fields, self.rates):
             a[:] = data[f"rates_{k}"]

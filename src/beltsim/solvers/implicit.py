@@ -50,6 +50,34 @@ BDF2_ERROR = 2.0 / 9.0  # leading error constant of BDF2 at a constant step
 NEWTON_CUT = 0.25  # step factor after a failed Newton solve
 
 
+@njit(cache=True)
+def step_factor(err, tol, ok, max_growth):
+    """The next step over this one under local error control (error ~ h^3): after a
+    converged step with error estimate err, SAFETY (tol / err)^(1/3) within [MIN_SHRINK,
+    max_growth]; after a failed Newton solve (ok false), NEWTON_CUT."""
+    if not ok:
+        return NEWTON_CUT
+    if err == 0.0:
+        return max_growth
+    return min(max_growth, max(MIN_SHRINK, SAFETY * (tol / err) ** (1.0 / 3.0)))
+
+
+@njit(cache=True)
+def copy_state(u, th, ud, td, lam, u_n, th_n, ud_n, td_n, lam_n):
+    """(u, th, ud, td, lam) = (u_n, ...): the state saved at t_n, or a rejected step's
+    state back to t_n."""
+    for j in range(u.shape[0]):
+        u[j], th[j], ud[j], td[j], lam[j] = u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j]
+
+
+@njit(cache=True)
+def landing_step(remaining, h_next, h_max):
+    """The step that ends on the stop time: the remaining span in equal parts of at most
+    min(h_next, h_max)."""
+    parts = math.ceil(remaining / min(h_next, h_max) * (1.0 - 1e-12))
+    return remaining / parts, parts
+
+
 class History(NamedTuple):
     """What BDF2 keeps of the past: the previous step's state and the accelerations now."""
 
@@ -128,11 +156,8 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
         if remaining <= 1e-9 * h_next:  # round-off of the caller's times, not a step
             t = t_stop
             break
-        # steps that end on t_stop: the remaining span in equal parts of at most h_next
-        parts = math.ceil(remaining / min(h_next, h_max) * (1.0 - 1e-12))
-        h = remaining / parts
-        for j in range(N + 1):
-            u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j] = u[j], th[j], ud[j], td[j], lam[j]
+        h, parts = landing_step(remaining, h_next, h_max)
+        copy_state(u_n, th_n, ud_n, td_n, lam_n, u, th, ud, td, lam)
         if h_prev > 0.0:
             r = h / h_prev
             a0 = (1.0 + 2.0 * r) / ((1.0 + r) * h)
@@ -193,34 +218,25 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
             for k in range(power.shape[0]):
                 work[k] += 0.5 * h * (power[k] + p_new[k])
                 power[k] = p_new[k]
-            factor = MAX_GROWTH if err == 0.0 else SAFETY * (tol / err) ** (1.0 / 3.0)
-            h_next = h * min(MAX_GROWTH, max(MIN_SHRINK, factor))
+            h_next = h * step_factor(err, tol, True, MAX_GROWTH)
             continue
         # rejected: back to t_n with a smaller step
         rejected += 1
         w.stats[0].failed_steps += 1
-        for j in range(N + 1):
-            u[j], th[j], ud[j], td[j], lam[j] = u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j]
-        if ok:
-            h_next = h * max(MIN_SHRINK, SAFETY * (tol / err) ** (1.0 / 3.0))
-        else:
-            h_next = h * NEWTON_CUT
+        copy_state(u, th, ud, td, lam, u_n, th_n, ud_n, td_n, lam_n)
+        h_next = h * step_factor(err, tol, ok, MAX_GROWTH)
         if h_next < h_min:
             return FAILED, t, h_prev, h_next, steps, rejected
     return OK, t, h_prev, h_next, steps, rejected
 
 
-@register
-class ImplicitScheme(NewtonScheme):
-    """Variable-step BDF2 with local error control: the time-accurate default."""
-
-    name = "implicit"
+class AdaptiveScheme(NewtonScheme):
+    """What the adaptive time-accurate schemes share: the last and the next step, and the
+    power terms with their time integrals (the power balance)."""
 
     def __init__(self, disc):
         super().__init__(disc)
-        n = disc.grid.n_elements + 1
-        self.hist = History.zeros(n)
-        self.h_prev = 0.0  # no previous step: the first is backward Euler
+        self.h_prev = 0.0  # no previous step
         self.h_next = self.numerics.dt
         self.power = np.zeros(len(POWER_TERMS))  # at the current time
         self.work_done = np.zeros(len(POWER_TERMS))  # integrals since the start
@@ -228,6 +244,30 @@ class ImplicitScheme(NewtonScheme):
     @property
     def dt(self) -> float:
         return self.h_next
+
+    def work_integrals(self) -> dict:
+        """The time integrals (J) of the power terms since the start of the run."""
+        return dict(zip(POWER_TERMS, (float(v) for v in self.work_done)))
+
+    def checkpoint(self) -> dict:
+        return {**super().checkpoint(), "h": np.array([self.h_prev, self.h_next]),
+                "power": self.power.copy(), "work_done": self.work_done.copy()}
+
+    def restore(self, data: dict) -> None:
+        super().restore(data)
+        self.h_prev, self.h_next = (float(v) for v in data["h"])
+        self.power[:], self.work_done[:] = data["power"], data["work_done"]
+
+
+@register
+class ImplicitScheme(AdaptiveScheme):
+    """Variable-step BDF2 with local error control (the first step backward Euler)."""
+
+    name = "implicit"
+
+    def __init__(self, disc):
+        super().__init__(disc)
+        self.hist = History.zeros(disc.grid.n_elements + 1)
 
     def advance(self, state, t, t_stop, max_steps=10**9):
         d, num = self.disc, self.numerics
@@ -239,19 +279,12 @@ class ImplicitScheme(NewtonScheme):
         self.check_status(status, t, self.h_next)
         return t
 
-    def work_integrals(self) -> dict:
-        """The time integrals (J) of the power terms since the start of the run."""
-        return dict(zip(POWER_TERMS, (float(v) for v in self.work_done)))
-
     def checkpoint(self) -> dict:
-        return {**super().checkpoint(), "h": np.array([self.h_prev, self.h_next]),
-                "power": self.power.copy(), "work_done": self.work_done.copy(),
+        return {**super().checkpoint(),
                 **{f"hist_{k}": a.copy() for k, a in zip(History._fields, self.hist)}}
 
     def restore(self, data: dict) -> None:
         super().restore(data)
-        self.h_prev, self.h_next = (float(v) for v in data["h"])
-        self.power[:], self.work_done[:] = data["power"], data["work_done"]
         for k, a in zip(History._fields, self.hist):
             # a checkpoint of an earlier version has no friction ratios at t_{n-1}: zeros
             # give the next step's Newton solve a worse start, nothing else
