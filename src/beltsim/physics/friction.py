@@ -77,7 +77,7 @@ def law_inverse(code, lam):
 
 
 def law_inverse_numpy(code, lam):
-    """Vectorised twin of :func:`law_inverse` (the numpy port of the default scheme)."""
+    """Vectorised twin of :func:`law_inverse` (the numpy port of the BDF2 scheme)."""
     lam = np.asarray(lam, dtype=float)
     if code == LINEAR:
         return lam, np.ones_like(lam)
