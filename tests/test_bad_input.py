@@ -57,6 +57,11 @@ CORPUS = {
         'numerics.friction_law: a "stick" scene takes only "exact"'),
     "exact with v_reg": (PAPER + '\n[numerics]\nfriction_law = "exact"\nregularisation = 1e-3\n',
                          'numerics.regularisation: not with numerics.friction_law = "exact"'),
+    "unknown gyroscopic form": (PAPER + '\n[numerics]\ngyroscopic = "skew"\n',
+                                'numerics.gyroscopic: must be one of "upwind" | "central"'),
+    "explicit central": (PAPER + '\n[numerics]\ngyroscopic = "central"\n'
+                         'integrator = "explicit"\n',
+                         'numerics.gyroscopic: "central" is for the implicit schemes'),
 }
 
 

@@ -328,6 +328,11 @@ def validate(data: dict) -> dict:
             if key in out["numerics"]:
                 raise SceneError(f"numerics.{key}", 'not with numerics.friction_law = "exact" '
                                  "(exact friction has no regularisation)")
+    numerics = out.get("numerics", {})
+    if numerics.get("gyroscopic", "upwind") != "upwind" and (
+            numerics.get("integrator") == "explicit"):
+        raise SceneError("numerics.gyroscopic", '"central" is for the implicit schemes; the '
+                         'explicit scheme has the upwind form only')
     for section, key in _ONLY_INERTIA:
         if key in out.get(section, {}) and not inertia:
             raise SceneError(f"{section}.{key}", "only for physics.inertia = true "

@@ -159,9 +159,6 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         omega1 = math.pi * P.B / (P.L * math.sqrt(P.rho * P.b1))
         acceleration = nm.get("acceleration", 2.0 * omega1)
     gyroscopic = nm.get("gyroscopic", "upwind")
-    if gyroscopic != "upwind" and integrator == "explicit":
-        raise SceneError("numerics.gyroscopic", '"central" is for the implicit schemes; the '
-                         'explicit scheme has the upwind form only')
     if "max_work" in nm and integrator != "explicit":
         raise SceneError("numerics.max_work", 'only for numerics.integrator = "explicit" (the '
                          "other schemes' steps adapt)")
