@@ -73,7 +73,8 @@ def run_ours(scene: Scene, repeat=3, log=print) -> tuple[dict, object, object]:
     exact = reference_of(scene).total_friction
     res = _ours(scene, repeat)
     total = res.solution.total_friction
-    out = {"elements": res.solution.grid.n_elements, "ours_wall_time": res.wall_time,
+    out = {"elements": res.solution.grid.n_elements, "ours_integrator": res.numerics.integrator,
+           "ours_wall_time": res.wall_time,
            "ours_error": relative_error(total, exact), "ours_converged": res.converged,
            "ours_steps": res.steps, "ours_total_friction": total}
     log(f"ours   ({res.numerics.integrator}, {out['elements']} elements): "
