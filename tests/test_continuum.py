@@ -4,7 +4,6 @@ closed forms and against the discrete model's spectrum under refinement."""
 import math
 
 import pytest
-import scipy.sparse.linalg as spla
 
 from beltsim.physics import continuum, modes
 from beltsim.physics.continuum import Characteristic, Zone
@@ -59,13 +58,6 @@ def test_zones_follow_the_exact_steady_state():
         continuum.characteristic(shipped_scene("paper_quasistatic"))
 
 
-def _nearest_discrete(scene, N, target, gyroscopic):
-    disc, state = modes.steady_discretisation(
-        scene.with_overrides([("numerics.gyroscopic", gyroscopic)]), N)
-    A = modes.companion(*modes.linearisation(disc, state)).astype(complex)
-    return complex(spla.eigs(A, k=1, sigma=target, return_eigenvectors=False)[0])
-
-
 @pytest.mark.verification
 def test_the_central_discrete_spectrum_converges_to_the_exact_roots_at_second_order():
     """paper_slip's growing mode near 531 Hz: the discrete model with the central
@@ -76,10 +68,11 @@ def test_the_central_discrete_spectrum_converges_to_the_exact_roots_at_second_or
     roots = continuum.characteristic(scene).roots(560.0, 500.0)
     exact = roots[0]
     assert exact.real > 0.0 and abs(exact.imag / (2 * math.pi) - 531.36) < 0.05
-    errors = [abs(_nearest_discrete(scene, N, exact, "central") - exact)
+    central = scene.with_overrides([("numerics.gyroscopic", "central")])
+    errors = [abs(modes.nearest_eigenvalue(central, exact, N) - exact)
               for N in (1200, 2400, 4800)]
     assert errors[0] / errors[1] >= 3.0 and errors[1] / errors[2] >= 3.0, errors
-    upwind = _nearest_discrete(scene, 2400, exact, "upwind")
+    upwind = modes.nearest_eigenvalue(scene, exact, 2400)
     assert upwind.real < exact.real - 20.0, upwind
 
 

@@ -7,7 +7,6 @@ import math
 import time
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 from beltsim.physics import modes
 from beltsim.problem.scene import shipped_scene
@@ -38,14 +37,6 @@ def fixed_law(scene) -> list:
     if P.friction == "coulomb":
         return [("numerics.regularisation", num.regularisation)]
     return [("numerics.adhesion_layer", DEFAULT_ADHESION_LAYER * P.L)]
-
-
-def nearest_discrete(scene, elements: int, target: complex, gyroscopic: str) -> complex:
-    """The discrete model's eigenvalue nearest to ``target`` (shift-invert)."""
-    sc = scene.with_overrides([("numerics.gyroscopic", gyroscopic)])
-    disc, state = modes.steady_discretisation(sc, elements)
-    A = modes.companion(*modes.linearisation(disc, state)).astype(complex)
-    return complex(spla.eigs(A, k=1, sigma=target, return_eigenvectors=False)[0])
 
 
 def hz(lam: complex) -> float:
@@ -111,7 +102,8 @@ def convergence_section(page: Page, cfg: dict, exact: dict) -> dict:
             for N in cfg["ladder"]:
                 cells = [name, f"{z.real:+.4f} at {hz(z):.3f} Hz", str(N)]
                 for form in ("central", "upwind"):
-                    lam = nearest_discrete(scene, N, z, form)
+                    lam = modes.nearest_eigenvalue(
+                        scene.with_overrides([("numerics.gyroscopic", form)]), z, N)
                     err = abs(lam - z)
                     order = (fmt(math.log2(prev[form] / err), ".2f")
                              if form in prev and err > 0 else "")

@@ -213,29 +213,32 @@ class Characteristic:
                 return complex(lam)
         return None
 
-    def roots(self, f_max, f_min=0.0, starts_per_hz=STARTS_PER_HZ, rates=START_RATES):
-        """The roots with frequencies in [f_min, f_max] Hz (upper half plane), by Newton
-        from a grid of starts; sorted by decreasing real part."""
-        found: list[complex] = []
+    def roots(self, f_max, f_min=0.0, starts_per_hz=STARTS_PER_HZ, rates=START_RATES,
+              seeds=()):
+        """The roots with frequencies in [f_min, f_max] Hz (upper half plane, the neutral
+        root left out), by Newton from a grid of starts in the band and from ``seeds``
+        (approximate eigenvalues, e.g. a discrete model's); sorted by decreasing real
+        part."""
         n = max(2, int(math.ceil((f_max - f_min) * starts_per_hz)))
-        for f in np.linspace(f_min, f_max, n + 1):
-            for r in rates:
-                lam = self.root(complex(r, 2.0 * math.pi * max(f, 1e-3)))
-                if (lam is None or lam.imag < 0.0 or abs(lam) < NEUTRAL
-                        or not f_min <= lam.imag / (2 * math.pi) <= f_max):
-                    continue
-                if all(abs(lam - o) > 1e-7 * abs(lam) for o in found):
-                    found.append(lam)
+        starts = [complex(r, 2.0 * math.pi * max(f, 1e-3))
+                  for f in np.linspace(f_min, f_max, n + 1) for r in rates]
+        found: list[complex] = []
+        for start in [*starts, *(complex(z) for z in seeds)]:
+            lam = self.root(start)
+            if (lam is None or lam.imag < 0.0 or abs(lam) < NEUTRAL
+                    or not f_min <= lam.imag / (2 * math.pi) <= f_max):
+                continue
+            if all(abs(lam - o) > 1e-7 * abs(lam) for o in found):
+                found.append(lam)
         return np.array(sorted(found, key=lambda z: -z.real))
 
 
-def characteristic(scene, damping=None) -> Characteristic:
+def characteristic(scene) -> Characteristic:
     """The characteristic matrix of a straight-belt scene about its exact steady state,
-    with the scene's damping (or ``damping``). Raises ValueError for a quasistatic scene."""
+    with the scene's damping. Raises ValueError for a quasistatic scene."""
     from ..problem import analytic
 
     P = scene.params
     if not P.inertia:
         raise ValueError("a quasistatic scene has no dynamics to linearise")
-    d = P.damping if damping is None else damping
-    return Characteristic(P, zones_of(analytic.solve(scene)), d)
+    return Characteristic(P, zones_of(analytic.solve(scene)), P.damping)

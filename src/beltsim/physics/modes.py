@@ -145,14 +145,25 @@ def growth_rate(scene, dense_elements=DENSE_ELEMENTS) -> Growth:
     cdisc, cstate = steady_discretisation(scene, dense_elements)
     eigs = spectrum(cdisc, cstate)
     coarse = _growth(_largest(eigs), dense_elements, "dense")
-    A = companion(*linearisation(disc, state)).astype(complex)
-    found = []
-    for sigma in _candidates(eigs, CANDIDATES):
-        found.append(spla.eigs(A, k=NEAREST, sigma=sigma, which="LM",
-                               return_eigenvectors=False, tol=1e-10, maxiter=5000))
+    A = companion(*linearisation(disc, state))
+    found = [eigenvalues_near(A, sigma, NEAREST) for sigma in _candidates(eigs, CANDIDATES)]
     return _growth(_largest(np.concatenate(found)), N,
                    f"shift-invert near the {dense_elements}-element grid's least stable "
                    f"modes", coarse)
+
+
+def eigenvalues_near(A, sigma, k=1) -> np.ndarray:
+    """The k eigenvalues of the companion matrix A (:func:`companion`) nearest to sigma
+    (ARPACK in shift-invert mode)."""
+    return spla.eigs(A.astype(complex), k=k, sigma=sigma, which="LM",
+                     return_eigenvectors=False, tol=1e-10, maxiter=5000)
+
+
+def nearest_eigenvalue(scene, target, elements=None) -> complex:
+    """The eigenvalue nearest to ``target`` of the scene's discrete model (its grid, or
+    ``elements``) linearised about its steady state."""
+    A = companion(*linearisation(*steady_discretisation(scene, elements)))
+    return complex(eigenvalues_near(A, target)[0])
 
 
 def _candidates(eigs, k):
@@ -189,14 +200,7 @@ def exact_spectrum(scene, f_max: float, damping: float | None = None,
     eigs = spectrum(disc, state)
     seeds = eigs[(eigs.imag > 0.0) & (eigs.imag < 2.0 * math.pi * 1.05 * f_max)
                  & (eigs.real > SEED_FLOOR)]
-    found = list(ch.roots(f_max))
-    for lam in seeds:
-        root = ch.root(complex(lam))
-        if (root is not None and 0.0 <= root.imag <= 2.0 * math.pi * f_max
-                and abs(root) >= continuum.NEUTRAL
-                and all(abs(root - o) > 1e-7 * abs(root) for o in found)):
-            found.append(root)
-    return np.array(sorted(found, key=lambda z: -z.real))
+    return ch.roots(f_max, seeds=seeds)
 
 
 def exact_growth(scene, f_max: float, damping: float | None = None) -> Growth:
