@@ -127,8 +127,8 @@ def test_the_saddle_block_lu_solves_like_a_dense_solve():
     # 3x3 blocks, two lower bands and one upper, zero (2, 2) entries like stick rows
     rng = np.random.default_rng(3)
     N = 12
-    s = Saddle.allocate(N)
     n = N - 1
+    s = Saddle.allocate(n)
     dense = np.zeros((3 * n, 3 * n))
     for i in range(n):
         for band, off in ((s.Db, 0), (s.Lb, -1), (s.L2, -2), (s.Ub, 1)):
@@ -139,7 +139,7 @@ def test_the_saddle_block_lu_solves_like_a_dense_solve():
                 band[i] = blk
                 dense[3 * i:3 * i + 3, 3 * (i + off):3 * (i + off) + 3] = blk
     s.R[:] = rng.standard_normal((n, 3))
-    assert saddle_factor(s)
-    saddle_substitute(s)
+    assert saddle_factor(s, n)
+    saddle_substitute(s, s.R, s.dx)
     np.testing.assert_allclose(s.dx.ravel(), np.linalg.solve(dense, s.R.ravel()), rtol=1e-10,
                                atol=1e-12)

@@ -69,7 +69,7 @@ def _random_state(grid, seed, amp=1e-3):
 def _assemble(d, u, th, lam, old, inv_dt, t, p, loads=None):
     w = Workspace.allocate(d.grid.n_elements)
     fnode = np.zeros_like(u)
-    assemble(u, th, lam, fnode, old, inv_dt, t, d.mesh, p, d.drive,
+    assemble(u, th, lam, np.zeros(0), fnode, old, inv_dt, t, d.mesh, p, d.drive,
              d.loads if loads is None else loads, w, True)
     return w, fnode
 
@@ -100,7 +100,8 @@ def _kernel_and_reference(code, inertia, inv_dt, loads, seed=1, gyro=UPWIND):
     w, fnode = _assemble(d, u, th, lam, old, inv_dt, t, p, ld)
     ratios = None
     if code >= EXACT:
-        add_stick_penalty(w, inv_dt, p.friction_scale * friction_factor(d.drive, t), d.mesh, p)
+        add_stick_penalty(w, inv_dt, p.friction_scale * friction_factor(d.drive, t), p.speed,
+                          d.mesh, p)
         ratios = lam
     R, F = reference.residual(u, th, old, inv_dt, t, d.mesh, p, d.drive, ld, ratios)
     J = reference.jacobian(u, th, old, inv_dt, t, d.mesh, p, d.drive, ratios).toarray()
@@ -323,13 +324,13 @@ def test_update_multipliers_stays_inside_and_follows_linearisation():
     dx = np.zeros((grid.n_elements - 1, 2))
     # a huge push towards +1: the 99% fraction-to-boundary rule applies
     rl[contact] = 100.0
-    big = update_multipliers(lam, dx, 0.0, d.mesh, p, w)
+    big = update_multipliers(lam, dx, np.zeros(0), 0.0, p.speed, d.mesh, p, w)
     np.testing.assert_allclose(lam[contact], 0.5 + 0.99 * 0.5)
     assert big == pytest.approx(0.495)
     # a small push: the linearised update sg * rl
     lam[contact] = 0.0
     rl[contact] = 0.1
-    update_multipliers(lam, dx, 0.0, d.mesh, p, w)
+    update_multipliers(lam, dx, np.zeros(0), 0.0, p.speed, d.mesh, p, w)
     np.testing.assert_allclose(lam[contact], 0.075)
 
 

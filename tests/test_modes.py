@@ -62,10 +62,11 @@ def _kernel_jacobian(disc, state, s):
     w = Workspace.allocate(N)
     zero = np.zeros(N + 1)
     old = State(state.u, state.theta, state.lam, zero, zero, zero)
-    assemble(state.u.copy(), state.theta.copy(), state.lam.copy(), zero.copy(), old, s, 0.0,
+    assemble(state.u.copy(), state.theta.copy(), state.lam.copy(), np.zeros(0), zero.copy(),
+             old, s, 0.0,
              disc.mesh, p, Drive.constant(P.v - P.c), Loads.none(N + 1), w, True)
     if is_exact(p.law):
-        add_stick_penalty(w, s, p.friction_scale, disc.mesh, p)
+        add_stick_penalty(w, s, p.friction_scale, p.speed, disc.mesh, p)
     return blocks_to_dense(w.Lb, w.Db, w.Ub, w.L2)
 
 

@@ -39,7 +39,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..problem.drive import friction_factor, mismatch
+from ..problem.drive import friction_factor, mismatch, value
 from .friction import (
     ADHESION,
     AUGMENTATION,
@@ -78,31 +78,58 @@ class ModelParams(NamedTuple):
     law: int  # friction law code (friction.LAW_CODES)
     dual: int  # 1: the friction ratio is a Newton unknown (primal-dual form)
     gyro: int = 0  # the gyroscopic term's form: UPWIND or CENTRAL
+    # a closed loop's belt speed c is an unknown: its stiffnesses b1 - rho c^2, a - I c^2
+    # follow it, and N0 (the installation tension) enters the pressure and the creep
+    b1: float = 0.0
+    a: float = 0.0
+    N0: float = 0.0
 
 
 class Mesh(NamedTuple):
-    """The grid as the kernels read it, with the contact's friction stencil.
+    """A layout on its grid as the kernels read it: the nodes, the contact's friction
+    stencil, the contact segments and the closure.
 
-    Friction acts at the contact nodes c0..j2: node j carries the nodal force
-    F_j = -wf_j f_s lam_j, lam_j the friction ratio of its slip velocity
-    v_rel,j = d/dt u_b,j + c sum_o sw[j, o] u_b,{j-2+o} - (v - c) (offsets -2..0).
+    Open (the paper's belt, ``off`` = 1): nodes 0..N with u = theta = 0 at both ends,
+    the unknowns at the interior nodes 1..N-1 (row i is node i + 1). Closed (a loop,
+    ``off`` = 0): nodes 0..N-1, periodic, every node an unknown (row i is node i), and
+    element j is [x_j, x_{j+1}] with x_N = x_0 + the loop's length.
+
+    Friction acts at the nodes ``cn``: node j carries the nodal force F_j = -wf_j S_j
+    lam_j, lam_j the friction ratio of its slip velocity v_rel,j = d/dt u_b,j + c sum_o
+    sw[j, o] u_b,{j-2+o} - target (offsets -2..0, periodic on a loop). On segment s
+    = seg[j] the bound S_j is f_s (a plate; seg_mu[s] = 0) or seg_mu[s] p_j with the
+    pressure p_j = (N0 + b1 u_x - rho c^2) / seg_radius[s] (a pulley's arc); the target
+    is v(t) - c on an open layout, and on a loop the rim speed less the belt's material
+    speed c (1 + N0 / b1): the drive's prescribed rim speed where seg_speed[s] < 0, else
+    that of the free pulley whose speed is the global unknown seg_speed[s].
     """
 
     he: np.ndarray  # element lengths (N)
-    hb: np.ndarray  # nodal control-volume lengths (N + 1)
-    j1: int  # node at x1
-    j2: int  # node at x2
-    c0: int  # first friction node
-    wf: np.ndarray  # friction weight (m) of each node (N + 1), 0 off the friction nodes
-    sw: np.ndarray  # d/dx u_b at node j: weights of u_b at j-2, j-1, j (N + 1, 3)
+    hb: np.ndarray  # nodal control-volume lengths (N + 1 open, N closed)
+    j1: int  # open: node at x1
+    j2: int  # open: node at x2
+    c0: int  # open: first friction node
+    wf: np.ndarray  # friction weight (m) of each node, 0 off the friction nodes
+    sw: np.ndarray  # d/dx u_b at node j: weights of u_b at j-2, j-1, j (nodes, 3)
+    off: int = 1  # node of row 0: 1 open, 0 closed
+    cn: np.ndarray = np.zeros(0, dtype=np.int64)  # the friction nodes, in order
+    seg: np.ndarray = np.zeros(0, dtype=np.int64)  # contact segment of each node, -1 off
+    seg_mu: np.ndarray = np.zeros(0)  # friction coefficient of a pulley arc; 0: a plate
+    seg_radius: np.ndarray = np.zeros(0)  # pulley radius (m)
+    seg_speed: np.ndarray = np.zeros(0, dtype=np.int64)  # global of the rim speed, or -1
+    loop_length: float = 0.0  # closed: the loop's length Lambda (m)
+    inertia: np.ndarray = np.zeros(0)  # closed: J of each global (0 for c), kg m^2
 
 
 class State(NamedTuple):
-    """The discrete state: nodal fields, their local rates, and the friction unknowns.
+    """The discrete state: nodal fields, their local rates, the friction unknowns and
+    the layout's global unknowns.
 
     ``lam`` holds, at contact nodes, the friction ratio g(v_rel / v_reg) (Newton
     schemes) or the argument v_rel / v_reg itself (the explicit scheme's warm start);
-    ``fnode`` the nodal friction forces of the state (N).
+    ``fnode`` the nodal friction forces of the state (N). ``g`` holds a loop's global
+    unknowns (its belt speed c, then the free pulleys' speeds), ``gd`` their rates;
+    both are empty on an open layout.
     """
 
     u: np.ndarray
@@ -111,11 +138,14 @@ class State(NamedTuple):
     ud: np.ndarray
     td: np.ndarray
     fnode: np.ndarray
+    g: np.ndarray = np.zeros(0)
+    gd: np.ndarray = np.zeros(0)
 
     @classmethod
-    def zeros(cls, n_nodes: int) -> State:
-        """The state at rest on ``n_nodes`` nodes."""
-        return cls(*(np.zeros(n_nodes) for _ in cls._fields))
+    def zeros(cls, n_nodes: int, n_globals: int = 0) -> State:
+        """The state at rest on ``n_nodes`` nodes with ``n_globals`` global unknowns."""
+        return cls(*(np.zeros(n_nodes) for _ in range(6)), np.zeros(n_globals),
+                   np.zeros(n_globals))
 
     def copy(self) -> State:
         """A copy of every array."""
@@ -228,42 +258,61 @@ def contact_stencil(x, j1, j2):
 
 
 def mesh_of(grid) -> Mesh:
-    """The grid as the kernels read it (:class:`Mesh`), with its contact stencil."""
+    """The open layout of a grid as the kernels read it (:class:`Mesh`): one plate
+    contact on [x1, x2], with its friction stencil."""
     c0, wf, sw = contact_stencil(grid.x, grid.j1, grid.j2)
-    return Mesh(grid.he, grid.hbar, grid.j1, grid.j2, c0, wf, sw)
+    seg = -np.ones(len(grid.x), dtype=np.int64)
+    seg[c0:grid.j2 + 1] = 0
+    return Mesh(grid.he, grid.hbar, grid.j1, grid.j2, c0, wf, sw, off=1,
+                cn=np.arange(c0, grid.j2 + 1, dtype=np.int64), seg=seg,
+                seg_mu=np.zeros(1), seg_radius=np.zeros(1),
+                seg_speed=-np.ones(1, dtype=np.int64))
+
+
+def n_rows(mesh: Mesh) -> int:
+    """The rows (nodes with unknowns) of a layout: N - 1 open, N closed."""
+    return len(mesh.hb) - 2 * mesh.off
+
+
+@njit(cache=True, inline="always")
+def wrap(k, n):
+    """Node k of a periodic grid of n nodes (k >= -n)."""
+    return k + n if k < 0 else (k - n if k >= n else k)
 
 
 @njit(cache=True)
 def bottom_strain(u, th, hh, sw, j):
-    """d/dx u_b at friction node j from the stencil weights sw[j]."""
+    """d/dx u_b at friction node j from the stencil weights sw[j] (periodic on a loop)."""
     e = 0.0
+    n = u.shape[0]
     for o in range(3):
         k = j - 2 + o
         if sw[j, o] != 0.0:
+            k = wrap(k, n)
             e += sw[j, o] * (u[k] + hh * th[k])
     return e
 
 
 @njit(cache=True, inline="always")
-def gyro_weights(hbj, hl, p):
+def gyro_weights(hbj, hl, c, gyro):
     """(diagonal, lower, upper) weights of the gyroscopic term 2 c v_x over node j's
     control volume, per unit mass: upwind 2 c hbar_j (v_j - v_{j-1}) / h_{j-1}, or the
     Galerkin form of linear elements c (v_{j+1} - v_{j-1}), skew-symmetric on any grid."""
-    if p.gyro == CENTRAL:
-        return 0.0, -p.speed, p.speed
-    g = 2.0 * p.speed * hbj / hl
+    if gyro == CENTRAL:
+        return 0.0, -c, c
+    g = 2.0 * c * hbj / hl
     return g, -g, 0.0
 
 
 @njit(cache=True, inline="always")
-def rate_blocks(hbj, hl, inv_dt, p):
+def rate_blocks(hbj, hl, inv_dt, c, p):
     """The terms in inv_dt of interior row j's Jacobian (its time-derivative part), but
     for friction: the lumped inertia and damping m_j (inv_dt^2 + d inv_dt) and the
     gyroscopic term (:func:`gyro_weights`) times inv_dt, m_j = rho hbar_j in the u row
     and I hbar_j in the theta row. Returns the (diagonal, lower, upper) entries of the u
     row and of the theta row."""
     kin = inv_dt * inv_dt + p.damping * inv_dt  # d(acc + damp * vel)/dy
-    g0, gl, gu = gyro_weights(hbj, hl, p)
+    g0, gl, gu = gyro_weights(hbj, hl, c, p.gyro)
     rho, I = p.mass, p.rotary_inertia
     return (rho * hbj * kin + rho * g0 * inv_dt, rho * gl * inv_dt, rho * gu * inv_dt,
             I * hbj * kin + I * g0 * inv_dt, I * gl * inv_dt, I * gu * inv_dt)
@@ -287,13 +336,47 @@ def friction_stiffness(wfj, fs, sgj, p):
     return wfj * fs * sgj / p.regularisation
 
 
-@njit(cache=True)
-def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_jac):
-    """Residual w.R (n, 2) of the interior nodes and, if want_jac, the Jacobian blocks.
+@njit(cache=True, inline="always")
+def loop_speed(g, p):
+    """The belt speed c: a loop's first global unknown, or the open layout's constant."""
+    return g[0] if g.shape[0] > 0 else p.speed
 
-    u, th, lam: trial values at t (N+1, boundary zeros); old: the State at the
-    previous step (its values and local velocities). fnode receives the nodal
-    friction forces (N) of the trial state.
+
+@njit(cache=True, inline="always")
+def contact_target(s, c, g, rim, open_target, mesh, p):
+    """v_rel's target at a node of segment s: v(t) - c on an open layout; on a loop the
+    rim speed (prescribed, or the free pulley's) less the material speed c (1 + N0 / b1)."""
+    if mesh.off == 1:
+        return open_target
+    k = mesh.seg_speed[s]
+    r = rim if k < 0 else g[k] * mesh.seg_radius[s]
+    return r - c * (1.0 + p.N0 / p.b1)
+
+
+@njit(cache=True, inline="always")
+def bound_scale(s, j, u, c, fs, mesh, p):
+    """(S_j, dS/du_x, dS/dc): the friction bound of node j on segment s, f_s on a plate,
+    mu p_j = mu (N0 + b1 u_x - rho c^2) / R on a pulley's arc (u_x from the stencil)."""
+    mu = mesh.seg_mu[s]
+    if mu == 0.0:
+        return fs, 0.0, 0.0
+    n = u.shape[0]
+    eps = 0.0
+    for o in range(3):
+        eps += mesh.sw[j, o] * u[wrap(j - 2 + o, n)]
+    R = mesh.seg_radius[s]
+    return (mu * (p.N0 + p.b1 * eps - p.mass * c * c) / R, mu * p.b1 / R,
+            -2.0 * mu * p.mass * c / R)
+
+
+@njit(cache=True)
+def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_jac):
+    """Residual w.R (n, 2) of the rows and, if want_jac, the Jacobian blocks.
+
+    u, th, lam: trial values at t (open: N+1 with boundary zeros; closed: N); g: the
+    trial global unknowns (a loop's c and free pulleys' speeds; empty when open); old:
+    the State at the previous step (its values and local velocities). fnode receives the
+    nodal friction forces of the trial state.
 
     Friction ratio lam = g(v_rel / v_reg) at each contact node: in the primal
     form (p.dual = 0) it is computed from the trial state; in the primal-dual form
@@ -304,48 +387,83 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
 
     The exact laws (friction.EXACT, ADHESION; p.regularisation is then the
     augmentation velocity v_aug) keep lam as a full unknown of a semi-smooth Newton
-    iteration (:mod:`beltsim.solvers.ssn`): its force enters as it is, with no Jacobian
-    entry here; rl receives v_rel / v_aug and sg 1 where lam + rl projects inside
-    [-1, 1] (stick) and 0 where it slides.
+    iteration (:mod:`beltsim.solvers.ssn`): its force enters as it is (its slope in
+    lam is the saddle system's); rl receives v_rel / v_aug and sg 1 where lam + rl
+    projects inside [-1, 1] (stick) and 0 where it slides.
+
+    A loop (mesh.off = 0) adds its global rows and columns: w.Rg the gauge (the mean of
+    u, in metres) and each free pulley's J omega_t + M(t) + R (sum of its arc's F),
+    w.Gc (n, 2, ng) the rows' slopes in the globals, w.Gr (ng, n, 2) the global rows'
+    slopes in the nodes' unknowns, w.Gd (ng, ng); the belt's c_t enters every axial row.
+    Its rows wrap round the loop: the band blocks Lb, L2 of rows 0 and 1 and Ub of the
+    last row couple to nodes across the closure (solvers.border solves with them).
 
     :mod:`beltsim.physics.reference` writes the same equations with numpy.
     """
-    N = u.shape[0] - 1
-    B, A, b2 = p.B, p.A, p.shear
-    rho, I, c, hh = p.mass, p.rotary_inertia, p.speed, p.half_height
+    nn = u.shape[0]
+    off = mesh.off
+    closed = off == 0
+    n = nn - 2 * off
+    rho, I, hh = p.mass, p.rotary_inertia, p.half_height
+    c = loop_speed(g, p)
+    if closed:
+        B, A = p.b1 - rho * c * c, p.a - I * c * c
+        cd = (c - old.g[0]) * inv_dt
+    else:
+        B, A = p.B, p.A
+        cd = 0.0
+    b2 = p.shear
     damp = p.damping
     fs = p.friction_scale * friction_factor(drive, t)
-    he, hb, j2 = mesh.he, mesh.hb, mesh.j2
-    c0, wf, sw = mesh.c0, mesh.wf, mesh.sw
+    he, hb = mesh.he, mesh.hb
+    wf, sw = mesh.wf, mesh.sw
     uo, tho, udo, tdo = old.u, old.theta, old.ud, old.td
     R, Lb, Db, Ub, rl, sg = w.R, w.Lb, w.Db, w.Ub, w.rl, w.sg
     L2 = w.L2
     target = mismatch(drive, t)
+    rim = value(drive.speed, t)
     lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
     code, dual = p.law, p.dual
-    for j in range(N + 1):
+    ng = g.shape[0]
+    for j in range(nn):
         fnode[j] = 0.0
-    for j in range(1, N):
-        i = j - 1
-        hl, hr, hbj = he[j - 1], he[j], hb[j]
+    if closed:
+        w.Rg[0] = 0.0
+        for k in range(1, ng):
+            w.Rg[k] = mesh.inertia[k] * (g[k] - old.g[k]) * inv_dt + value(drive.load, t)
+        if want_jac:
+            w.Gc[:, :, :] = 0.0
+            w.Gr[:, :, :] = 0.0
+            w.Gd[:, :] = 0.0
+            for k in range(1, ng):
+                w.Gd[k, k] = mesh.inertia[k] * inv_dt
+    for i in range(n):
+        j = i + off
+        jm = j - 1 if j > 0 else nn - 1
+        jp = j + 1 if j < nn - 1 else 0
+        hl, hr, hbj = he[jm], he[j], hb[j]
         udj = (u[j] - uo[j]) * inv_dt
         tdj = (th[j] - tho[j]) * inv_dt
-        ud_l = (u[j - 1] - uo[j - 1]) * inv_dt
-        td_l = (th[j - 1] - tho[j - 1]) * inv_dt
-        ud_r = (u[j + 1] - uo[j + 1]) * inv_dt
-        td_r = (th[j + 1] - tho[j + 1]) * inv_dt
-        g0, gl, gu = gyro_weights(hbj, hl, p)  # 2 c u_xt over the control volume
+        ud_l = (u[jm] - uo[jm]) * inv_dt
+        td_l = (th[jm] - tho[jm]) * inv_dt
+        ud_r = (u[jp] - uo[jp]) * inv_dt
+        td_r = (th[jp] - tho[jp]) * inv_dt
+        g0, gl, gu = gyro_weights(hbj, hl, c, p.gyro)  # 2 c u_xt over the control volume
         acc_u = (udj - udo[j]) * inv_dt + damp * udj
         acc_t = (tdj - tdo[j]) * inv_dt + damp * tdj
-        ru = (rho * hbj * acc_u + rho * (g0 * udj + gl * ud_l + gu * ud_r)
-              - B * ((u[j + 1] - u[j]) / hr - (u[j] - u[j - 1]) / hl))
-        rt = (I * hbj * acc_t + I * (g0 * tdj + gl * td_l + gu * td_r)
-              - A * ((th[j + 1] - th[j]) / hr - (th[j] - th[j - 1]) / hl) + b2 * hbj * th[j])
+        lap_u = (u[jp] - u[j]) / hr - (u[j] - u[jm]) / hl
+        lap_t = (th[jp] - th[j]) / hr - (th[j] - th[jm]) / hl
+        ru = rho * hbj * acc_u + rho * (g0 * udj + gl * ud_l + gu * ud_r) - B * lap_u
+        rt = (I * hbj * acc_t + I * (g0 * tdj + gl * td_l + gu * td_r) - A * lap_t
+              + b2 * hbj * th[j])
+        if closed:
+            ru += rho * hbj * cd
         if lk >= 0:
             ru -= hbj * load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j)
             rt -= hbj * load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j)
+        s = mesh.seg[j]
         if want_jac:
-            if j >= c0 and j <= j2:
+            if s >= 0:
                 # friction adds to these rows' couplings and second band; elsewhere they
                 # keep the zeros they were allocated with (the blocks' other entries)
                 for a_ in range(2):
@@ -354,27 +472,45 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
                         L2[i, a_, b_] = 0.0
                         Db[i, a_, b_] = 0.0
                         Ub[i, a_, b_] = 0.0
-            du, lu, uu, dt_, lt, ut = rate_blocks(hbj, hl, inv_dt, p)
+            du, lu, uu, dt_, lt, ut = rate_blocks(hbj, hl, inv_dt, c, p)
             Db[i, 0, 0] = du + B * (1.0 / hl + 1.0 / hr)
             Lb[i, 0, 0] = lu - B / hl
             Ub[i, 0, 0] = uu - B / hr
             Db[i, 1, 1] = dt_ + A * (1.0 / hl + 1.0 / hr) + b2 * hbj
             Lb[i, 1, 1] = lt - A / hl
             Ub[i, 1, 1] = ut - A / hr
-        if j >= c0 and j <= j2:
+            if closed:
+                # d/dc: the c_t term, the gyroscopic term (linear in c) and B(c), A(c)
+                e0, el, eu = gyro_weights(hbj, hl, 1.0, p.gyro)
+                w.Gc[i, 0, 0] = (rho * hbj * inv_dt + rho * (e0 * udj + el * ud_l + eu * ud_r)
+                                 + 2.0 * rho * c * lap_u)
+                w.Gc[i, 1, 0] = I * (e0 * tdj + el * td_l + eu * td_r) + 2.0 * I * c * lap_t
+                w.Gr[0, i, 0] = hbj / mesh.loop_length
+        if closed:
+            w.Rg[0] += hbj * u[j] / mesh.loop_length
+        if s >= 0:
             # slip velocity at node j (stencil sw[j]), friction on its weight wf[j]
             ub = u[j] + hh * th[j]
             ubo = uo[j] + hh * tho[j]
-            vrel = (ub - ubo) * inv_dt + c * bottom_strain(u, th, hh, sw, j) - target
+            eb = bottom_strain(u, th, hh, sw, j)
+            vrel = ((ub - ubo) * inv_dt + c * eb
+                    - contact_target(s, c, g, rim, target, mesh, p))
+            S, dSe, dSc = bound_scale(s, j, u, c, fs, mesh, p)
+            w.bs[j] = S
+            if closed:
+                w.vc[j] = 1.0 + p.N0 / p.b1 + eb
             if code >= EXACT:
                 # lam is the semi-smooth Newton's own unknown (solvers.ssn): its force
                 # enters as it is; rl: v_rel / v_aug; sg: 1 where proj(lam + rl) sticks
                 rl[j] = vrel / p.regularisation
                 z = lam[j] + rl[j]
                 sg[j] = 0.0 if code == EXACT and abs(z) >= 1.0 else 1.0
-                fnode[j] = -wf[j] * fs * lam[j]
-                ru += wf[j] * fs * lam[j]
-                rt += hh * wf[j] * fs * lam[j]
+                fnode[j] = -wf[j] * S * lam[j]
+                ru += wf[j] * S * lam[j]
+                rt += hh * wf[j] * S * lam[j]
+                if closed:
+                    loop_friction(w, i, j, s, lam[j], 0.0, dSe, dSc, S, inv_dt, c, hh,
+                                  mesh, p, want_jac)
                 R[i, 0] = ru
                 R[i, 1] = rt
                 continue
@@ -386,14 +522,53 @@ def assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, want_j
                 lam[j], sg[j] = law(code, vrel / p.regularisation)
                 rl[j] = 0.0
             wj = wf[j]
-            fnode[j] = -wj * fs * lam[j]
-            ru += wj * fs * (lam[j] + sg[j] * rl[j])
-            rt += hh * wj * fs * (lam[j] + sg[j] * rl[j])
+            fnode[j] = -wj * S * lam[j]
+            ru += wj * S * (lam[j] + sg[j] * rl[j])
+            rt += hh * wj * S * (lam[j] + sg[j] * rl[j])
             if want_jac:
-                add_friction_slope(w, i, j, friction_stiffness(wj, fs, sg[j], p), inv_dt, c,
+                add_friction_slope(w, i, j, friction_stiffness(wj, S, sg[j], p), inv_dt, c,
                                    hh, sw)
+            if closed:
+                loop_friction(w, i, j, s, lam[j] + sg[j] * rl[j],
+                              friction_stiffness(wj, S, sg[j], p), dSe, dSc, S, inv_dt, c, hh,
+                              mesh, p, want_jac)
         R[i, 0] = ru
         R[i, 1] = rt
+
+
+@njit(cache=True)
+def loop_friction(w, i, j, s, m, k, dSe, dSc, S, inv_dt, c, hh, mesh, p, want_jac):
+    """A loop's friction terms at node j (row i) beyond the open layout's: the slopes of
+    its force wf S m (m the ratio, condensed for a regularised law) through the pressure
+    bound S(u_x, c) and through v_rel in the globals (k = -dF/dv_rel), and the force's
+    moment on its free pulley's row with all its slopes."""
+    wj = mesh.wf[j]
+    K = mesh.seg_speed[s]
+    Rs = mesh.seg_radius[s]
+    n = w.R.shape[0]
+    if K >= 1:
+        w.Rg[K] -= Rs * wj * S * m
+    if not want_jac:
+        return
+    gc = k * w.vc[j] + wj * m * dSc  # d(force)/dc
+    w.Gc[i, 0, 0] += gc
+    w.Gc[i, 1, 0] += hh * gc
+    if K >= 1:
+        w.Gc[i, 0, K] -= k * Rs
+        w.Gc[i, 1, K] -= hh * k * Rs
+        w.Gd[K, 0] -= Rs * gc
+        w.Gd[K, K] += Rs * k * Rs
+    for o in range(3):
+        q = wrap(j - 2 + o, n)
+        dp = wj * m * dSe * mesh.sw[j, o]  # through the pressure, u only
+        if dp != 0.0:
+            blk = stencil_band(o, w.L2, w.Lb, w.Db)
+            blk[i, 0, 0] += dp
+            blk[i, 1, 0] += hh * dp
+        if K >= 1:
+            dv = k * slip_velocity_slope(mesh.sw, j, o, c, inv_dt)
+            w.Gr[K, q, 0] -= Rs * (dv + dp)
+            w.Gr[K, q, 1] -= Rs * dv * hh
 
 
 @njit(cache=True)
@@ -404,14 +579,14 @@ def rate_part(e, a0, fs, sg, mesh, p, out):
     he, hb, hh = mesh.he, mesh.hb, p.half_height
     for i in range(e.shape[0]):
         j = i + 1
-        du, lu, uu, dt_, lt, ut = rate_blocks(hb[j], he[j - 1], a0, p)
+        du, lu, uu, dt_, lt, ut = rate_blocks(hb[j], he[j - 1], a0, p.speed, p)
         ul = e[i - 1, 0] if i > 0 else 0.0
         tl = e[i - 1, 1] if i > 0 else 0.0
         ur = e[i + 1, 0] if i + 1 < e.shape[0] else 0.0
         tr = e[i + 1, 1] if i + 1 < e.shape[0] else 0.0
         out[i, 0] = du * e[i, 0] + lu * ul + uu * ur
         out[i, 1] = dt_ * e[i, 1] + lt * tl + ut * tr
-        if mesh.c0 <= j <= mesh.j2:
+        if mesh.seg[j] >= 0:
             k = friction_stiffness(mesh.wf[j], fs, sg[j], p) * own_rate_slope(2, a0)
             eb = e[i, 0] + hh * e[i, 1]
             out[i, 0] += k * eb
@@ -419,15 +594,21 @@ def rate_part(e, a0, fs, sg, mesh, p, out):
 
 
 @njit(cache=True)
-def add_stick_penalty(w, inv_dt, fs, mesh, p):
+def add_stick_penalty(w, inv_dt, fs, c, mesh, p):
     """After an exact law's assembly: the stuck nodes' constraint v_rel = 0 as the slope
     f_s AUGMENTATION / v_aug (the default regularisation's) in the 2x2 Jacobian blocks,
     w.sg scaled to match. The 2x2 stand-in of the semi-smooth Newton's 3x3 system, for
-    what needs a 2x2 Jacobian: the implicit scheme's error filter, the linearisation."""
-    for j in range(mesh.c0, mesh.j2 + 1):
+    what needs a 2x2 Jacobian: the implicit scheme's error filter, the linearisation.
+    (fs: the open layout's friction scale; a loop's nodes take their bounds w.bs, and
+    their slopes reach its globals: c the belt speed of the assembly.)"""
+    for j in mesh.cn:
         w.sg[j] *= AUGMENTATION
-        add_friction_slope(w, j - 1, j, friction_stiffness(mesh.wf[j], fs, w.sg[j], p),
-                           inv_dt, p.speed, p.half_height, mesh.sw)
+        S = fs if mesh.off == 1 else w.bs[j]
+        k = friction_stiffness(mesh.wf[j], S, w.sg[j], p)
+        add_friction_slope(w, j - mesh.off, j, k, inv_dt, c, p.half_height, mesh.sw)
+        if mesh.off == 0:
+            loop_friction(w, j, j, mesh.seg[j], 0.0, k, 0.0, 0.0, S, inv_dt, c,
+                          p.half_height, mesh, p, True)
 
 
 # a call, not inline="always": inlined, this choice made assemble three times slower
@@ -456,23 +637,31 @@ def add_friction_slope(w, i, j, k, inv_dt, c, hh, sw):
 
 
 @njit(cache=True)
-def update_multipliers(lam, dx, inv_dt, mesh, p, w):
-    """Newton update of the friction ratios after the condensed solve.
+def update_multipliers(lam, dx, dg, inv_dt, c, mesh, p, w):
+    """Newton update of the friction ratios after the condensed solve (dx the rows'
+    update, dg the globals'; c the belt speed of the assembly).
 
     Each lam moves at most 99% of the way to the boundary of (-1, 1) (fraction to
     the boundary) and stays within LAM_MAX of it, so g^{-1}(lam) stays finite.
     Returns the largest change.
     """
-    c, hh = p.speed, p.half_height
+    hh = p.half_height
     rl, sg, sw = w.rl, w.sg, mesh.sw
+    off = mesh.off
+    nn = sw.shape[0]
     big = 0.0
-    for j in range(mesh.c0, mesh.j2 + 1):
+    for j in mesh.cn:
         dvrel = 0.0
         for o in range(3):
-            k = j - 2 + o
-            if k >= 1:
+            k = wrap(j - 2 + o, nn)
+            if k >= off:
                 dvrel += (slip_velocity_slope(sw, j, o, c, inv_dt)
-                          * (dx[k - 1, 0] + hh * dx[k - 1, 1]))
+                          * (dx[k - off, 0] + hh * dx[k - off, 1]))
+        if off == 0:
+            dvrel += w.vc[j] * dg[0]
+            K = mesh.seg_speed[mesh.seg[j]]
+            if K >= 1:
+                dvrel -= mesh.seg_radius[mesh.seg[j]] * dg[K]
         dl = sg[j] * (rl[j] + dvrel / p.regularisation)
         if lam[j] + dl >= 1.0:
             dl = 0.99 * (1.0 - lam[j])
@@ -520,7 +709,7 @@ def power_terms(state, t, mesh, p, drive, loads, out):
     surface = 0.0
     transport = 0.0
     slip = 0.0
-    for j in range(mesh.c0, mesh.j2 + 1):
+    for j in mesh.cn:
         strain_b = bottom_strain(u, th, hh, mesh.sw, j)
         vrel = ud[j] + hh * td[j] + c * strain_b - target
         surface += target * F[j]
@@ -537,7 +726,7 @@ def power_terms(state, t, mesh, p, drive, loads, out):
                              + load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j) * td[j])
     gyro = 0.0
     for j in range(1, u.shape[0] - 1):
-        g0, gl, gu = gyro_weights(hb[j], he[j - 1], p)
+        g0, gl, gu = gyro_weights(hb[j], he[j - 1], p.speed, p.gyro)
         gyro += (p.mass * ud[j] * (g0 * ud[j] + gl * ud[j - 1] + gu * ud[j + 1])
                  + p.rotary_inertia * td[j] * (g0 * td[j] + gl * td[j - 1] + gu * td[j + 1]))
     out[0], out[1], out[2], out[3], out[4], out[5] = (surface, transport, load, slip,

@@ -47,15 +47,22 @@ class Profile(NamedTuple):
 
 
 class Drive(NamedTuple):
-    """The drive of a run: the surface speed's mismatch and the friction limit's factor."""
+    """The drive of a run: the surface speed and the friction limit's factor, and on a
+    loop the free pulley's load.
 
-    speed: Profile  # v(t) - c (m/s)
+    On an open layout ``speed`` is the mismatch v(t) - c; on a loop it is the driver's
+    rim speed omega_1(t) R_1 and ``load`` the torque M(t) that the free pulley delivers.
+    """
+
+    speed: Profile  # v(t) - c (m/s), or a loop's driver rim speed (m/s)
     friction: Profile  # f*(t) / f* (1 for perfect adhesion)
+    load: Profile = Profile.constant(0.0)  # a loop's load torque (N m)
 
     @classmethod
-    def constant(cls, mismatch: float) -> Drive:
-        """The full mismatch at once and a constant friction limit (the steady solver)."""
-        return cls(Profile.constant(mismatch), Profile.constant(1.0))
+    def constant(cls, mismatch: float, load: float = 0.0) -> Drive:
+        """The full mismatch (or rim speed) and load at once and a constant friction
+        limit (the steady solver)."""
+        return cls(Profile.constant(mismatch), Profile.constant(1.0), Profile.constant(load))
 
 
 @njit(cache=True)

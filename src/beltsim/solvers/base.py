@@ -22,6 +22,8 @@ class Scales(NamedTuple):
     moment: float
     u: float
     theta: float
+    glob: np.ndarray = np.zeros(0)  # a loop's global unknowns (their updates' scales)
+    gres: np.ndarray = np.zeros(0)  # and their rows' (the residuals')
 
 
 def scales_of(P) -> Scales:
@@ -52,9 +54,12 @@ class Discretisation:
         self.loads: Loads = Loads.none(self.grid.n_elements + 1)
         self.scales: Scales = scales_of(P)
 
+    #: the layout's global unknowns (none on the open layout)
+    n_globals = 0
+
     def new_state(self) -> State:
         """The belt at rest."""
-        return State.zeros(self.grid.n_elements + 1)
+        return State.zeros(len(self.mesh.hb), self.n_globals)
 
 
 class Scheme:

@@ -110,7 +110,7 @@ def initial_acceleration(state, base, t, mesh, p, drive, loads, w, au, at):
     for j in range(N + 1):
         base.u[j], base.theta[j] = u[j] - ud[j], th[j] - td[j]
         base.ud[j], base.td[j] = ud[j], td[j]
-    assemble(u, th, lam, state.fnode, base, 1.0, t, mesh, p, drive, loads, w, False)
+    assemble(u, th, lam, state.g, state.fnode, base, 1.0, t, mesh, p, drive, loads, w, False)
     au[0] = au[N] = at[0] = at[N] = 0.0
     for j in range(1, N):
         au[j] = -w.R[j - 1, 0] / (p.mass * mesh.hb[j]) if p.mass > 0.0 else 0.0

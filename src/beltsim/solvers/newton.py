@@ -18,10 +18,17 @@ from numba import njit
 
 from ..errors import FailureKind, NumericalError
 from ..physics.friction import EXACT, is_exact, law, law_inverse
-from ..physics.model import add_stick_penalty, assemble, update_multipliers
+from ..physics.model import (
+    add_stick_penalty,
+    assemble,
+    bound_scale,
+    loop_speed,
+    update_multipliers,
+)
 from ..problem.drive import friction_factor
 from .base import Scheme
-from .ssn import Saddle, project, saddle_factor, saddle_substitute, saddle_system
+from .border import Border, finish, gather, schur
+from .ssn import Saddle, project, saddle_solve, saddle_system
 
 # status codes of the time-stepping kernels that solve with Newton
 OK, FAILED, NONFINITE = 0, 1, 2
@@ -51,9 +58,9 @@ class NewtonSettings(NamedTuple):
 
 
 class Workspace(NamedTuple):
-    """Preallocated arrays of the Newton kernels (grid of N elements)."""
+    """Preallocated arrays of the Newton kernels (n rows: N - 1 open, N closed)."""
 
-    R: np.ndarray  # residual (n, 2), n = N - 1 interior nodes
+    R: np.ndarray  # residual (n, 2)
     Lb: np.ndarray  # Jacobian blocks (n, 2, 2)
     L2: np.ndarray  # second lower band (the friction stencil reaches node j - 2)
     Db: np.ndarray
@@ -63,38 +70,57 @@ class Workspace(NamedTuple):
     W2: np.ndarray  # those of the second lower band,
     U: np.ndarray  # upper blocks (a line search assembles Ub anew)
     dx: np.ndarray  # Newton update (n, 2)
-    u_try: np.ndarray  # line-search trial (N + 1)
+    u_try: np.ndarray  # line-search trial (nodes)
     th_try: np.ndarray
-    rl: np.ndarray  # friction equation residuals (N + 1)
-    sg: np.ndarray  # friction slopes (N + 1)
+    rl: np.ndarray  # friction equation residuals (nodes)
+    sg: np.ndarray  # friction slopes (nodes)
     sgf: np.ndarray  # those of the factorised Jacobian
-    lam0: np.ndarray  # friction ratios before the last update (N + 1)
+    lam0: np.ndarray  # friction ratios before the last update (nodes)
     stats: np.ndarray  # one record of STATS_DTYPE
     saddle: Saddle  # the exact laws' 3x3 system (empty for the regularised ones)
+    bs: np.ndarray  # friction bound S_j of each friction node at the last assembly
+    vc: np.ndarray  # a loop's d v_rel / dc at each friction node
+    Rg: np.ndarray  # a loop's global rows: residual (ng), slopes (physics.model.assemble)
+    Gc: np.ndarray  # (n, 2, ng)
+    Gr: np.ndarray  # (ng, n, 2)
+    Gd: np.ndarray  # (ng, ng)
+    dg: np.ndarray  # the globals' Newton update
+    g_try: np.ndarray  # their line-search trial
+    border: Border  # a loop's bordered solve (empty when open)
 
     @classmethod
-    def allocate(cls, n_elements: int, exact: bool = False) -> Workspace:
-        """The arrays for a grid of ``n_elements`` (``exact``: an exact law's too)."""
-        N, n = n_elements, n_elements - 1
-        return cls(R=np.zeros((n, 2)), Lb=np.zeros((n, 2, 2)), L2=np.zeros((n, 2, 2)),
-                   Db=np.zeros((n, 2, 2)),
-                   Ub=np.zeros((n, 2, 2)), C=np.zeros((n, 2, 2)), W=np.zeros((n, 2, 2)),
-                   W2=np.zeros((n, 2, 2)),
-                   U=np.zeros((n, 2, 2)), dx=np.zeros((n, 2)),
-                   u_try=np.zeros(N + 1), th_try=np.zeros(N + 1), rl=np.zeros(N + 1),
-                   sg=np.zeros(N + 1), sgf=np.zeros(N + 1), lam0=np.zeros(N + 1),
+    def allocate(cls, n_elements: int, exact: bool = False, closed: bool = False,
+                 n_globals: int = 0) -> Workspace:
+        """The arrays for a grid of ``n_elements`` (``exact``: an exact law's too;
+        ``closed``: a loop with ``n_globals`` global unknowns)."""
+        N = n_elements
+        nodes, n = (N, N) if closed else (N + 1, N - 1)
+        ng = n_globals
+        z = np.zeros
+        return cls(R=z((n, 2)), Lb=z((n, 2, 2)), L2=z((n, 2, 2)), Db=z((n, 2, 2)),
+                   Ub=z((n, 2, 2)), C=z((n, 2, 2)), W=z((n, 2, 2)), W2=z((n, 2, 2)),
+                   U=z((n, 2, 2)), dx=z((n, 2)), u_try=z(nodes), th_try=z(nodes),
+                   rl=z(nodes), sg=z(nodes), sgf=z(nodes), lam0=z(nodes),
                    stats=np.zeros(1, STATS_DTYPE),
-                   saddle=Saddle.allocate(N) if exact else Saddle.empty())
+                   saddle=Saddle.allocate(n, ng if closed else 0, closed) if exact
+                   else Saddle.empty(),
+                   bs=z(nodes), vc=z(nodes), Rg=z(ng), Gc=z((n, 2, ng)), Gr=z((ng, n, 2)),
+                   Gd=z((ng, ng)), dg=z(ng), g_try=z(ng),
+                   border=Border.allocate(n, 2, ng) if closed else Border.empty())
 
 
 @njit(cache=True)
-def merit(R, scales):
-    """The squared residual norm, each row's force and moment over their scales."""
+def merit(R, Rg, scales):
+    """The squared residual norm, each row's force and moment over their scales, each
+    global row over its own."""
     m = 0.0
     for i in range(R.shape[0]):
         a = R[i, 0] / scales.force
         b = R[i, 1] / scales.moment
         m += a * a + b * b
+    for k in range(Rg.shape[0]):
+        a = Rg[k] / scales.gres[k]
+        m += a * a
     return m
 
 
@@ -182,19 +208,43 @@ def block_substitute(w, r, x):
 
 @njit(cache=True)
 def factorise(w, mesh):
-    """Factorise w's Jacobian blocks; keep the friction slopes they hold (w.sgf)."""
-    for j in range(mesh.c0, mesh.j2 + 1):
+    """Factorise w's Jacobian blocks (bordered on a loop); keep the friction slopes
+    they hold (w.sgf)."""
+    for j in mesh.cn:
         w.sgf[j] = w.sg[j]
-    return block_factor(w.Lb, w.Db, w.Ub, w)
+    if mesh.off == 1:
+        return block_factor(w.Lb, w.Db, w.Ub, w)
+    ni = w.Db.shape[0] - 2
+    if not block_factor(w.Lb[:ni], w.Db[:ni], w.Ub[:ni], w):
+        return False
+    bd = w.border
+    gather(w.Lb, w.L2, w.Db, w.Ub, w.Gc, w.Gr, w.Gd, bd)
+    for q in range(bd.Bm.shape[0]):
+        block_substitute(w, bd.Bm[q], bd.X[q])
+    return schur(bd)
 
 
 @njit(cache=True)
-def friction_forces(lam, fnode, t, mesh, p, drive):
+def linear_solve(w, mesh, r, rg, x, dg):
+    """x (n, 2) and dg (ng) from the right-hand sides r, rg with the factors of
+    :func:`factorise`; r and rg are kept."""
+    if mesh.off == 1:
+        block_substitute(w, r, x)
+        return
+    ni = r.shape[0] - 2
+    block_substitute(w, r[:ni], x[:ni])
+    finish(w.border, r, rg, x, dg)
+
+
+@njit(cache=True)
+def friction_forces(lam, fnode, u, g, t, mesh, p, drive):
     """The nodal friction forces of the friction ratios lam, as
     :func:`~beltsim.physics.model.assemble` sets them."""
     fs = p.friction_scale * friction_factor(drive, t)
-    for j in range(mesh.c0, mesh.j2 + 1):
-        fnode[j] = -mesh.wf[j] * fs * lam[j]
+    c = loop_speed(g, p)
+    for j in mesh.cn:
+        S, _, _ = bound_scale(mesh.seg[j], j, u, c, fs, mesh, p)
+        fnode[j] = -mesh.wf[j] * S * lam[j]
 
 
 @njit(cache=True)
@@ -210,7 +260,7 @@ def release_stuck_ratios(lam, w, mesh, code):
     1 + 2 abs(rl) per iteration), and Newton goes on.
     """
     stuck = False
-    for j in range(mesh.c0, mesh.j2 + 1):
+    for j in mesh.cn:
         if w.sg[j] < NEAR_BOUND and lam[j] * w.rl[j] < 0.0:
             s = w.rl[j] + law_inverse(code, w.lam0[j])[0]
             if abs(law(code, s)[0] - lam[j]) > LAW_GAP:
@@ -247,13 +297,16 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     """
     if p.law >= EXACT:
         return newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w)
-    u, th, lam, fnode = state.u, state.theta, state.lam, state.fnode
+    u, th, lam, fnode, g = state.u, state.theta, state.lam, state.fnode, state.g
     R, dx, u_try, th_try = w.R, w.dx, w.u_try, w.th_try
+    Rg, dg, g_try = w.Rg, w.dg, w.g_try
+    off = mesh.off
+    ng = g.shape[0]
     st = w.stats[0]
     tol = settings.tol
     n = R.shape[0]
-    assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
-    m0 = merit(R, scales)
+    assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+    m0 = merit(R, Rg, scales)
     if m0 == 0.0:
         return factorise(w, mesh)  # the factors are the step's (its error estimate's)
     previous = np.inf
@@ -262,31 +315,31 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
         for i in range(n):
             R[i, 0] = -R[i, 0]
             R[i, 1] = -R[i, 1]
+        for k in range(ng):
+            Rg[k] = -Rg[k]
         if not factorise(w, mesh):
-            st.merit = merit(R, scales)
+            st.merit = merit(R, Rg, scales)
             return False
-        block_substitute(w, R, dx)
-        step = 0.0
-        for i in range(n):
-            s = max(abs(dx[i, 0]) / scales.u, abs(dx[i, 1]) / scales.theta)
-            if s > step:
-                step = s
+        linear_solve(w, mesh, R, Rg, dx, dg)
+        step = update_size(dx, dg, scales)
         if not np.isfinite(step):
-            st.merit = merit(R, scales)
+            st.merit = merit(R, Rg, scales)
             return False
         if p.dual:
-            for j in range(mesh.c0, mesh.j2 + 1):
+            for j in mesh.cn:
                 w.lam0[j] = lam[j]
-            dlam = update_multipliers(lam, dx, inv_dt, mesh, p, w)
+            dlam = update_multipliers(lam, dx, dg, inv_dt, loop_speed(g, p), mesh, p, w)
             for i in range(n):
-                u[i + 1] += dx[i, 0]
-                th[i + 1] += dx[i, 1]
+                u[i + off] += dx[i, 0]
+                th[i + off] += dx[i, 1]
+            for k in range(ng):
+                g[k] += dg[k]
             update = max(step, dlam)
             if (update_converged(update, previous, it, tol)
                     and not release_stuck_ratios(lam, w, mesh, p.law)):
-                friction_forces(lam, fnode, t, mesh, p, drive)
+                friction_forces(lam, fnode, u, g, t, mesh, p, drive)
                 return True
-            assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+            assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
             previous = update
             continue
         alpha = 1.0
@@ -294,10 +347,13 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
         m = m0
         while alpha >= 1.0 / 4096.0:
             for i in range(n):
-                u_try[i + 1] = u[i + 1] + alpha * dx[i, 0]
-                th_try[i + 1] = th[i + 1] + alpha * dx[i, 1]
-            assemble(u_try, th_try, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
-            m = merit(R, scales)
+                u_try[i + off] = u[i + off] + alpha * dx[i, 0]
+                th_try[i + off] = th[i + off] + alpha * dx[i, 1]
+            for k in range(ng):
+                g_try[k] = g[k] + alpha * dg[k]
+            assemble(u_try, th_try, lam, g_try, fnode, old, inv_dt, t, mesh, p, drive, loads,
+                     w, True)
+            m = merit(R, Rg, scales)
             if m <= (1.0 - 1e-4 * alpha) * m0:
                 accepted = True
                 break
@@ -305,23 +361,38 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
             st.line_search_cuts += 1
         if not accepted:
             # no decrease possible: fine if already at round-off, else a failure
-            assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+            assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
             st.merit = m0
             return step < ROUNDOFF_FLOOR * tol
         for i in range(n):
-            u[i + 1] = u_try[i + 1]
-            th[i + 1] = th_try[i + 1]
+            u[i + off] = u_try[i + off]
+            th[i + off] = th_try[i + off]
+        for k in range(ng):
+            g[k] = g_try[k]
         m0 = m
         st.merit = m
         if alpha * step < tol or m < 1e-30:
             return True
-    st.merit = merit(R, scales)
+    st.merit = merit(R, Rg, scales)
     return False
 
 
 @njit(cache=True)
+def update_size(dx, dg, scales):
+    """The scaled max norm of a Newton update of the rows (dx) and the globals (dg)."""
+    step = 0.0
+    for i in range(dx.shape[0]):
+        s = max(abs(dx[i, 0]) / scales.u, abs(dx[i, 1]) / scales.theta)
+        if s > step:
+            step = s
+    for k in range(dg.shape[0]):
+        step = max(step, abs(dg[k]) / scales.glob[k])
+    return step
+
+
+@njit(cache=True)
 def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
-    """Semi-smooth Newton on (u, theta, lam) for the exact laws (:mod:`.ssn`).
+    """Semi-smooth Newton on (u, theta, lam) and the globals for the exact laws (:mod:`.ssn`).
 
     Full steps; converged when the update passes :func:`newton`'s tests and the
     stick/slip state of every friction node is the one the last step was solved with.
@@ -333,47 +404,49 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
     f_s AUGMENTATION / v_aug, the default regularisation's (a penalty standing in for
     their constraint), for the step's error estimate, as :func:`newton` leaves its own.
     """
-    u, th, lam, fnode = state.u, state.theta, state.lam, state.fnode
+    u, th, lam, fnode, g = state.u, state.theta, state.lam, state.fnode, state.g
     s = w.saddle
     st = w.stats[0]
     tol = settings.tol
     n = w.R.shape[0]
+    off = mesh.off
+    ng = g.shape[0]
     fs = p.friction_scale * friction_factor(drive, t)
     for j in range(s.active.shape[0]):
         s.active[j] = -1.0
-    assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
-    saddle_system(lam, inv_dt, fs, mesh, p, w, s)
+    assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+    saddle_system(lam, loop_speed(g, p), inv_dt, fs, mesh, p, w, s)
     previous = np.inf
     for it in range(settings.max_iterations):
         st.newton_iterations += 1
-        if not saddle_factor(s):
-            st.merit = merit(w.R, scales)
+        if not saddle_solve(s, mesh):
+            st.merit = merit(w.R, w.Rg, scales)
             return False
-        saddle_substitute(s)
-        step = 0.0
+        step = update_size(s.dx, s.dg, scales)
         dlam = 0.0
         for i in range(n):
-            step = max(step, abs(s.dx[i, 0]) / scales.u, abs(s.dx[i, 1]) / scales.theta)
             dlam = max(dlam, abs(s.dx[i, 2]))
         if not (np.isfinite(step) and np.isfinite(dlam)):
-            st.merit = merit(w.R, scales)
+            st.merit = merit(w.R, w.Rg, scales)
             return False
         for i in range(n):
-            u[i + 1] += s.dx[i, 0]
-            th[i + 1] += s.dx[i, 1]
-        for j in range(mesh.c0, mesh.j2 + 1):
-            lam[j] += s.dx[j - 1, 2]
-        assemble(u, th, lam, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
-        changed = saddle_system(lam, inv_dt, fs, mesh, p, w, s)
+            u[i + off] += s.dx[i, 0]
+            th[i + off] += s.dx[i, 1]
+        for k in range(ng):
+            g[k] += s.dg[k]
+        for j in mesh.cn:
+            lam[j] += s.dx[j - off, 2]
+        assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+        changed = saddle_system(lam, loop_speed(g, p), inv_dt, fs, mesh, p, w, s)
         update = max(step, dlam)
         done = changed == 0 and update_converged(update, previous, it, tol)
         previous = update
         if done:
             project(lam, mesh, p.law)  # the sliding ratios, off +-1 by round-off
-            friction_forces(lam, fnode, t, mesh, p, drive)
-            add_stick_penalty(w, inv_dt, fs, mesh, p)
+            friction_forces(lam, fnode, u, g, t, mesh, p, drive)
+            add_stick_penalty(w, inv_dt, fs, loop_speed(g, p), mesh, p)
             return factorise(w, mesh)
-    st.merit = merit(w.R, scales)
+    st.merit = merit(w.R, w.Rg, scales)
     return False
 
 
@@ -383,7 +456,8 @@ class NewtonScheme(Scheme):
     def __init__(self, disc):
         super().__init__(disc)
         num = self.numerics
-        self.work = Workspace.allocate(disc.grid.n_elements, is_exact(disc.model.law))
+        self.work = Workspace.allocate(disc.grid.n_elements, is_exact(disc.model.law),
+                                       disc.mesh.off == 0, disc.n_globals)
         self.settings = NewtonSettings(num.newton_tol, num.newton_max_iterations)
         # the previous step's state (with inv_dt = 0, the steady equations ignore it)
         self.old = disc.new_state()

@@ -24,10 +24,11 @@ from numba import njit
 
 from ..physics.friction import EXACT
 from ..physics.model import slip_velocity_slope, stencil_band
+from .border import Border, finish, gather, schur
 
 
 class Saddle(NamedTuple):
-    """The 3x3 block-banded system and its block LU (n interior nodes)."""
+    """The 3x3 block-banded system and its block LU (n rows), with a loop's border."""
 
     L2: np.ndarray  # (n, 3, 3) bands
     Lb: np.ndarray
@@ -38,34 +39,52 @@ class Saddle(NamedTuple):
     W2: np.ndarray
     R: np.ndarray  # right-hand side (n, 3)
     dx: np.ndarray  # solution (n, 3)
-    active: np.ndarray  # (N + 1) 1 where the node sticks, at the last assembly
+    active: np.ndarray  # (nodes) 1 where the node sticks, at the last assembly
+    Gc: np.ndarray  # a loop's global columns (n, 3, ng), rows (ng, n, 3), corner (ng, ng)
+    Gr: np.ndarray
+    Gd: np.ndarray
+    Rg: np.ndarray  # the global rows' right-hand side (ng) and solution (ng)
+    dg: np.ndarray
+    border: Border
 
     @classmethod
-    def allocate(cls, n_elements: int) -> Saddle:
-        """The arrays for a grid of ``n_elements``."""
-        n = max(n_elements - 1, 0)
+    def allocate(cls, n_rows: int, n_globals: int = 0, closed: bool = False) -> Saddle:
+        """The arrays for ``n_rows`` rows (N - 1 open, N closed) and a loop's globals."""
+        n, ng = max(n_rows, 0), n_globals
         z = np.zeros
         return cls(z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)),
-                   z((n, 3, 3)), z((n, 3, 3)), z((n, 3)), z((n, 3)), z(n_elements + 1))
+                   z((n, 3, 3)), z((n, 3, 3)), z((n, 3)), z((n, 3)), z(n + 2 - 2 * closed),
+                   z((n, 3, ng)), z((ng, n, 3)), z((ng, ng)), z(ng), z(ng),
+                   Border.allocate(n, 3, ng) if closed else Border.empty(3))
 
     @classmethod
     def empty(cls) -> Saddle:
         """Zero-size arrays, for a law that needs none (a regularised one)."""
-        return cls.allocate(0)
+        return cls.allocate(-1)
 
 
 @njit(cache=True)
-def saddle_system(lam, inv_dt, fs, mesh, p, w, s):
+def saddle_system(lam, c, inv_dt, fs, mesh, p, w, s):
     """The 3x3 blocks and right-hand side -F of the semi-smooth Newton step.
 
     w holds the model's 2x2 blocks and residual as :func:`beltsim.physics.model.assemble`
-    leaves them for an exact law (friction force wf f_s lam in the residual, no friction
-    slope; w.rl = v_rel / v_aug, w.sg = 1 where the node sticks). Returns the number of
-    friction nodes whose stick/slip state differs from the previous call's.
+    leaves them for an exact law (friction force wf S lam in the residual, no friction
+    slope; w.rl = v_rel / v_aug, w.sg = 1 where the node sticks; w.bs the bounds S);
+    c is the belt speed of that assembly.
+    On a loop the global rows and columns come along: a stuck node's v_rel depends on c
+    and on its free pulley's speed, and that pulley's row on the node's ratio. Returns
+    the number of friction nodes whose stick/slip state differs from the previous call's.
     """
     n = w.R.shape[0]
-    c, hh, vaug = p.speed, p.half_height, p.regularisation
+    off = mesh.off
+    hh, vaug = p.half_height, p.regularisation
+    ng = s.Rg.shape[0]
     changed = 0
+    if off == 0:
+        for k in range(ng):
+            s.Rg[k] = -w.Rg[k]
+            for m in range(ng):
+                s.Gd[k, m] = w.Gd[k, m]
     for i in range(n):
         for a in range(3):
             s.R[i, a] = 0.0
@@ -81,14 +100,25 @@ def saddle_system(lam, inv_dt, fs, mesh, p, w, s):
                 s.Lb[i, a, b] = w.Lb[i, a, b]
                 s.Db[i, a, b] = w.Db[i, a, b]
                 s.Ub[i, a, b] = w.Ub[i, a, b]
-        j = i + 1
-        if j < mesh.c0 or j > mesh.j2:
+        if off == 0:
+            for k in range(ng):
+                for a in range(2):
+                    s.Gc[i, a, k] = w.Gc[i, a, k]
+                    s.Gr[k, i, a] = w.Gr[k, i, a]
+                s.Gc[i, 2, k] = 0.0
+                s.Gr[k, i, 2] = 0.0
+        j = i + off
+        seg = mesh.seg[j]
+        if seg < 0:
             s.Db[i, 2, 2] = 1.0
             s.R[i, 2] = -lam[j]
             continue
-        k = mesh.wf[j] * fs
+        k = mesh.wf[j] * (fs if off == 1 else w.bs[j])
         s.Db[i, 0, 2] = k
         s.Db[i, 1, 2] = hh * k
+        K = mesh.seg_speed[seg] if off == 0 else -1
+        if K >= 1:
+            s.Gr[K, i, 2] = -mesh.seg_radius[seg] * k
         stick = w.sg[j] > 0.5
         if stick != (s.active[j] > 0.5):
             changed += 1
@@ -98,8 +128,12 @@ def saddle_system(lam, inv_dt, fs, mesh, p, w, s):
             s.R[i, 2] = -(lam[j] - math.copysign(1.0, lam[j] + w.rl[j]))
             continue
         s.R[i, 2] = -w.rl[j]
+        if off == 0:
+            s.Gc[i, 2, 0] = w.vc[j] / vaug
+            if K >= 1:
+                s.Gc[i, 2, K] = -mesh.seg_radius[seg] / vaug
         for o in range(3):
-            if j - 2 + o < 1:
+            if off == 1 and j - 2 + o < 1:
                 continue
             dd = slip_velocity_slope(mesh.sw, j, o, c, inv_dt) / vaug
             if dd == 0.0:
@@ -151,11 +185,11 @@ def _mul_sub(a, ia, b, ib, acc):
 
 
 @njit(cache=True)
-def saddle_factor(s):
-    """Block LU of the 3x3 block-banded system (as newton.block_factor for 2x2 blocks):
-    W2_i = L2_i S_{i-2}^{-1}, L'_i = L_i - W2_i U_{i-2}, W_i = L'_i S_{i-1}^{-1},
-    S_i = D_i - W_i U_{i-1}; s.C receives S_i^{-1}. Returns False on a singular pivot."""
-    n = s.Db.shape[0]
+def saddle_factor(s, n):
+    """Block LU of the first n rows of the 3x3 block-banded system (as
+    newton.block_factor for 2x2 blocks): W2_i = L2_i S_{i-2}^{-1}, L'_i = L_i - W2_i
+    U_{i-2}, W_i = L'_i S_{i-1}^{-1}, S_i = D_i - W_i U_{i-1}; s.C receives S_i^{-1}.
+    Returns False on a singular pivot."""
     Li = np.empty((1, 3, 3))
     S = np.empty((3, 3))
     for i in range(n):
@@ -177,14 +211,13 @@ def saddle_factor(s):
 
 
 @njit(cache=True)
-def saddle_substitute(s):
-    """s.dx from s.R with the factors of :func:`saddle_factor`."""
-    n = s.R.shape[0]
-    y = s.dx
+def saddle_substitute(s, r, y):
+    """y (n, 3) from r (n, 3) with the factors of :func:`saddle_factor` of n rows."""
+    n = r.shape[0]
     z = np.empty(3)
     for i in range(n):
         for a in range(3):
-            acc = s.R[i, a]
+            acc = r[i, a]
             if i > 0:
                 for b in range(3):
                     acc -= s.W[i, a, b] * y[i - 1, b]
@@ -204,9 +237,33 @@ def saddle_substitute(s):
 
 
 @njit(cache=True)
+def saddle_solve(s, mesh):
+    """Factorise the system (bordered on a loop) and solve it: s.dx (and s.dg) from s.R
+    (and s.Rg). Returns False on a singular pivot."""
+    n = s.Db.shape[0]
+    if mesh.off == 1:
+        if not saddle_factor(s, n):
+            return False
+        saddle_substitute(s, s.R, s.dx)
+        return True
+    ni = n - 2
+    if not saddle_factor(s, ni):
+        return False
+    bd = s.border
+    gather(s.Lb, s.L2, s.Db, s.Ub, s.Gc, s.Gr, s.Gd, bd)
+    for q in range(bd.Bm.shape[0]):
+        saddle_substitute(s, bd.Bm[q], bd.X[q])
+    if not schur(bd):
+        return False
+    saddle_substitute(s, s.R[:ni], s.dx[:ni])
+    finish(bd, s.R, s.Rg, s.dx, s.dg)
+    return True
+
+
+@njit(cache=True)
 def project(lam, mesh, code):
     """Ratios of sliding nodes back onto [-1, 1] (Coulomb): the update may overshoot."""
     if code != EXACT:
         return
-    for j in range(mesh.c0, mesh.j2 + 1):
+    for j in mesh.cn:
         lam[j] = min(1.0, max(-1.0, lam[j]))

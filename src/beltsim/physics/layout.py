@@ -1,0 +1,91 @@
+"""Layouts: where the belt runs, as data the one discrete model reads.
+
+A layout is a sequence of segments along the belt (a free span; contact with a moving
+plate of prescribed speed, the paper's; contact on a pulley's arc) and a closure: open,
+with the material entering at x = 0 and leaving at x = L at the speed c (the paper's
+control domain, :func:`beltsim.physics.model.mesh_of`), or a closed loop, whose belt
+speed c and free pulleys' speeds are global unknowns of the model (:func:`loop_mesh`).
+Both come out as a :class:`~beltsim.physics.model.Mesh`: the kernels, the schemes and the
+linear solve read nothing else.
+
+The two-pulley loop, in the loop coordinate x in [0, Lambda) of the belt's motion:
+driver arc (segment 0, its rim speed prescribed), slack span, driven arc (segment 1, its
+rim speed omega_2 R_2 the global unknown 1), tight span; global 0 is c.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .model import UPWIND, Mesh, ModelParams
+
+#: The fewest elements on each of a loop's segments.
+MIN_SEGMENT_ELEMENTS = 4
+
+
+def loop_nodes(lengths, elements: int) -> tuple[np.ndarray, np.ndarray]:
+    """(x, first): the nodes of a periodic grid with a node at each segment's start and
+    elements of about equal length (at least MIN_SEGMENT_ELEMENTS a segment), and the
+    index of each segment's first node (with the node count appended)."""
+    lengths = np.asarray(lengths, dtype=float)
+    counts = np.maximum(MIN_SEGMENT_ELEMENTS,
+                        np.round(elements * lengths / lengths.sum()).astype(int))
+    bounds = np.concatenate([[0.0], np.cumsum(lengths)])
+    x = np.concatenate([np.linspace(bounds[k], bounds[k + 1], counts[k], endpoint=False)
+                        for k in range(len(lengths))])
+    return x, np.concatenate([[0], np.cumsum(counts)])
+
+
+def loop_mesh(lengths, contacts, elements: int, mu: float,
+              inertia: tuple[float, ...]) -> Mesh:
+    """A closed layout on a periodic grid.
+
+    lengths: the segments' lengths in the loop's order; contacts: for each contact, a
+    tuple (segment index, radius, speed global) with speed global -1 for the driver (its
+    rim speed prescribed) or the index of the free pulley's speed among the globals;
+    mu: the friction coefficient of every arc (0: a constant bound, perfect adhesion);
+    inertia: J of each global (0 for c).
+
+    Each arc's friction acts from its entry node to its exit node (the next segment's
+    first), half volumes at both ends, as on the open layout's plate.
+    """
+    x, first = loop_nodes(lengths, elements)
+    N = len(x)
+    loop_length = float(np.sum(lengths))
+    he = np.diff(np.append(x, loop_length))
+    hb = 0.5 * (he + np.roll(he, 1))
+    seg = -np.ones(N, dtype=np.int64)
+    wf = np.zeros(N)
+    for s, (k, _, _) in enumerate(contacts):
+        j0, j1 = first[k], first[k + 1]
+        js = np.arange(j0, j1 + 1) % N
+        seg[js] = s
+        wf[js] = hb[js]
+        wf[j0 % N] = 0.5 * he[j0 % N]
+        wf[j1 % N] = 0.5 * he[(j1 - 1) % N]
+    h1 = np.roll(he, 1)  # x_j - x_{j-1}
+    h2 = np.roll(he, 2)  # x_{j-1} - x_{j-2}
+    sw = np.stack([h1 / (h2 * (h1 + h2)), -(h1 + h2) / (h1 * h2),
+                   (2.0 * h1 + h2) / (h1 * (h1 + h2))], axis=1)
+    return Mesh(he, hb, 0, 0, 0, wf, sw, off=0,
+                cn=np.flatnonzero(seg >= 0).astype(np.int64), seg=seg,
+                seg_mu=np.full(len(contacts), float(mu)),
+                seg_radius=np.array([r for _, r, _ in contacts], dtype=float),
+                seg_speed=np.array([k for _, _, k in contacts], dtype=np.int64),
+                loop_length=loop_length, inertia=np.asarray(inertia, dtype=float))
+
+
+def node_x(mesh: Mesh) -> np.ndarray:
+    """The nodes' coordinates of a layout's grid (from 0)."""
+    return np.concatenate([[0.0], np.cumsum(mesh.he)])[:len(mesh.hb)]
+
+
+def loop_params(*, a, b1, b2, rho, I, lever, damping, N0, law, dual, regularisation,
+                friction_scale=1.0, gyro=UPWIND) -> ModelParams:
+    """The model's coefficients on a loop: the stiffnesses b1, a (B and A follow the
+    belt speed, an unknown), the installation tension N0, the friction's lever and law;
+    friction_scale is the constant bound of perfect adhesion's reaction."""
+    return ModelParams(B=b1, A=a, shear=b2, mass=rho, rotary_inertia=I, speed=0.0,
+                       half_height=lever, damping=damping, friction_scale=friction_scale,
+                       regularisation=regularisation, law=law, dual=dual, gyro=gyro,
+                       b1=b1, a=a, N0=N0)

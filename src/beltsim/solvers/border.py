@@ -1,0 +1,151 @@
+"""The linear solve of a closed layout: the block band of an open one, bordered.
+
+A loop's rows couple across its closure (rows 0 and 1 reach back to nodes N-1 and N-2,
+row N-1 forward to node 0) and to its global unknowns (the belt speed c in every row,
+a free pulley's speed in its arc's rows; the gauge and the pulleys' rows are dense).
+The last two nodes and the globals form the border, of size nb = 2 b + ng (b the block
+size: 2 for (u, theta), 3 with an exact law's friction ratio). The first N - 2 rows are
+then an open layout's block band, factorised by the same block LU (newton.block_factor,
+ssn.saddle_factor); the border by its Schur complement
+
+    S = D - C A^{-1} B,
+
+with the band's substitution applied to the nb border columns once per factorisation.
+The cost stays linear in the grid: nb + 1 substitutions and an nb x nb inverse.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+
+class Border(NamedTuple):
+    """The border of a closed layout's Jacobian and its Schur complement.
+
+    Border unknown q < 2 b is unknown q % b of node N - 2 + q // b; q >= 2 b is global
+    q - 2 b. Columns and rows are stored as (nb, n_int, b) arrays over the band's rows.
+    """
+
+    Bm: np.ndarray  # the band rows' entries in the border columns (nb, n_int, b)
+    Cm: np.ndarray  # the border rows' entries in the band columns (nb, n_int, b)
+    Dm: np.ndarray  # the border's own block (nb, nb)
+    X: np.ndarray  # A^{-1} Bm (nb, n_int, b)
+    Sinv: np.ndarray  # the Schur complement's inverse (nb, nb)
+    rb: np.ndarray  # the border's right-hand side (nb)
+
+    @classmethod
+    def allocate(cls, n_rows: int, b: int, n_globals: int) -> Border:
+        """The arrays for a loop of ``n_rows`` nodes, blocks of ``b``, ``n_globals``."""
+        nb, ni = 2 * b + n_globals, max(n_rows - 2, 0)
+        return cls(np.zeros((nb, ni, b)), np.zeros((nb, ni, b)), np.zeros((nb, nb)),
+                   np.zeros((nb, ni, b)), np.zeros((nb, nb)), np.zeros(nb))
+
+    @classmethod
+    def empty(cls, b: int = 2) -> Border:
+        """No border: an open layout."""
+        return cls.allocate(0, b, -2 * b)
+
+
+@njit(cache=True)
+def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
+    """Fill bd's Bm, Cm, Dm from a loop's wrapped band (rows 0..n-1, each coupling to
+    nodes i-2, i-1, i, i+1 modulo n) and its global blocks Gc (n, b, ng), Gr (ng, n, b),
+    Gd (ng, ng)."""
+    n, b = Db.shape[0], Db.shape[1]
+    ni = n - 2
+    ng = Gd.shape[0]
+    bd.Bm[:, :, :] = 0.0
+    bd.Cm[:, :, :] = 0.0
+    bd.Dm[:, :] = 0.0
+    for a in range(b):
+        for q in range(b):
+            # band rows into the border nodes: rows 0, 1 back across the closure, row
+            # n - 3 forward to node n - 2
+            bd.Bm[q, 0, a] += L2[0, a, q]  # node n - 2
+            bd.Bm[b + q, 0, a] += Lb[0, a, q]  # node n - 1
+            bd.Bm[b + q, 1, a] += L2[1, a, q]
+            bd.Bm[q, ni - 1, a] += Ub[ni - 1, a, q]
+            # border rows into the band: node n - 2 back to n - 3, n - 4; node n - 1
+            # back to n - 3 and forward to node 0
+            bd.Cm[a, ni - 1, q] += Lb[n - 2, a, q]
+            bd.Cm[a, ni - 2, q] += L2[n - 2, a, q]
+            bd.Cm[b + a, ni - 1, q] += L2[n - 1, a, q]
+            bd.Cm[b + a, 0, q] += Ub[n - 1, a, q]
+            bd.Dm[a, q] = Db[n - 2, a, q]
+            bd.Dm[a, b + q] = Ub[n - 2, a, q]
+            bd.Dm[b + a, q] = Lb[n - 1, a, q]
+            bd.Dm[b + a, b + q] = Db[n - 1, a, q]
+    for k in range(ng):
+        for i in range(ni):
+            for a in range(b):
+                bd.Bm[2 * b + k, i, a] = Gc[i, a, k]
+                bd.Cm[2 * b + k, i, a] = Gr[k, i, a]
+        for a in range(b):
+            bd.Dm[a, 2 * b + k] = Gc[n - 2, a, k]
+            bd.Dm[b + a, 2 * b + k] = Gc[n - 1, a, k]
+            bd.Dm[2 * b + k, a] = Gr[k, n - 2, a]
+            bd.Dm[2 * b + k, b + a] = Gr[k, n - 1, a]
+        for m in range(ng):
+            bd.Dm[2 * b + k, 2 * b + m] = Gd[k, m]
+
+
+@njit(cache=True, error_model="numpy")
+def schur(bd):
+    """bd.Sinv from bd.X = A^{-1} Bm; False when the complement is singular."""
+    nb = bd.Dm.shape[0]
+    S = bd.Dm.copy()
+    for r in range(nb):
+        for q in range(nb):
+            acc = 0.0
+            for i in range(bd.Cm.shape[1]):
+                for a in range(bd.Cm.shape[2]):
+                    acc += bd.Cm[r, i, a] * bd.X[q, i, a]
+            S[r, q] -= acc
+    # scale rows and columns to unit diagonal-ish size: the border mixes metres, N and 1/s
+    d = np.ones(nb)
+    for r in range(nb):
+        m = 0.0
+        for q in range(nb):
+            m = max(m, abs(S[r, q]))
+        if m > 0.0:
+            d[r] = 1.0 / m
+    Sd = S * d.reshape(nb, 1)
+    if not np.all(np.isfinite(Sd)):
+        return False
+    if abs(np.linalg.det(Sd)) == 0.0:
+        return False
+    bd.Sinv[:, :] = np.linalg.inv(Sd) * d.reshape(1, nb)
+    return np.all(np.isfinite(bd.Sinv))
+
+
+@njit(cache=True)
+def finish(bd, r, rg, x, dg):
+    """Complete a bordered solve: x[:n-2] holds A^{-1} r[:n-2] on entry; on return x
+    (n, b) and dg (ng) solve the whole system with right-hand sides r (n, b), rg (ng)."""
+    n, b = r.shape[0], r.shape[1]
+    ni = n - 2
+    nb = bd.Dm.shape[0]
+    for a in range(b):
+        bd.rb[a] = r[n - 2, a]
+        bd.rb[b + a] = r[n - 1, a]
+    for k in range(nb - 2 * b):
+        bd.rb[2 * b + k] = rg[k]
+    for q in range(nb):
+        acc = 0.0
+        for i in range(ni):
+            for a in range(b):
+                acc += bd.Cm[q, i, a] * x[i, a]
+        bd.rb[q] -= acc
+    z = bd.Sinv @ bd.rb
+    for q in range(nb):
+        for i in range(ni):
+            for a in range(b):
+                x[i, a] -= bd.X[q, i, a] * z[q]
+    for a in range(b):
+        x[n - 2, a] = z[a]
+        x[n - 1, a] = z[b + a]
+    for k in range(nb - 2 * b):
+        dg[k] = z[2 * b + k]
