@@ -207,7 +207,7 @@ def test_rate_part_is_the_references_time_derivative_part(gyro):
     sg = rng.uniform(0.0, 1.0, len(grid.x))
     a0, fs = 2.7e3, 0.8 * p.friction_scale
     out = np.empty_like(e)
-    rate_part(e, a0, fs, sg, d.mesh, p, out)
+    rate_part(e, np.zeros(0), a0, fs, sg, sg, p.speed, d.mesh, p, out, np.zeros(0))
     ops = reference.operators(d.mesh, p)
     j = reference.contact_nodes(d.mesh)
     k = d.mesh.wf[j] * fs * sg[j] / p.regularisation

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from beltsim.physics.friction import LAW_CODES, TANH
-from beltsim.physics.layout import loop_mesh, loop_params
+from beltsim.physics.layout import LoopGrid, loop_mesh, loop_params
 from beltsim.physics.model import Loads, State, assemble
 from beltsim.problem.drive import Drive, Profile
 from beltsim.problem.scene import load_scene
@@ -20,7 +20,7 @@ pytestmark = pytest.mark.unit
 def _loop(law="tanh", elements=40, overrides=()):
     P = load_scene("drive_flat", list(overrides)).params
     g = P.geometry
-    mesh = loop_mesh(g.lengths, [(0, g.R1, -1), (2, g.R2, 1)], elements,
+    mesh = loop_mesh(LoopGrid.build(g.lengths, elements), [(0, g.R1, -1), (2, g.R2, 1)],
                      0.0 if P.mu is None else P.mu, (0.0, P.J2))
     prm = loop_params(a=P.a, b1=P.b1, b2=P.b2, rho=P.rho, I=P.I, lever=P.lever,
                       damping=P.damping, N0=P.N0, law=LAW_CODES[law], dual=0,

@@ -332,3 +332,13 @@ def solve_string(P: DriveParams, omega1: float | None = None,
 
 __all__ = ["SEGMENTS", "GrossSlipError", "LiftOffError", "StringSolution", "capacity",
            "solve_string"]
+
+
+def creep_speed(P: DriveParams) -> float:
+    """The slip velocities' scale omega1 R1 N0 / b1 (m/s), the creep of the pretension."""
+    return P.omega1 * P.geometry.R1 * P.N0 / P.b1
+
+
+def transit_time(P: DriveParams) -> float:
+    """Lambda / (omega1 R1): how long the belt takes once round the loop (s)."""
+    return P.geometry.loop_length / (P.omega1 * P.geometry.R1)

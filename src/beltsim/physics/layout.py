@@ -15,6 +15,8 @@ rim speed omega_2 R_2 the global unknown 1), tight span; global 0 is c.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .model import UPWIND, Mesh, ModelParams
@@ -36,11 +38,42 @@ def loop_nodes(lengths, elements: int) -> tuple[np.ndarray, np.ndarray]:
     return x, np.concatenate([[0], np.cumsum(counts)])
 
 
-def loop_mesh(lengths, contacts, elements: int, mu: float,
-              inertia: tuple[float, ...]) -> Mesh:
-    """A closed layout on a periodic grid.
+@dataclass(frozen=True)
+class LoopGrid:
+    """The nodes of a periodic grid on a loop of length ``loop_length``: x[0] = 0, and
+    element j is [x_j, x_{j+1}] with x_N = loop_length."""
 
-    lengths: the segments' lengths in the loop's order; contacts: for each contact, a
+    x: np.ndarray  # node coordinates (N)
+    loop_length: float
+    first: np.ndarray  # each segment's first node, and N
+
+    @classmethod
+    def build(cls, lengths, elements: int) -> LoopGrid:
+        """About ``elements`` elements of equal length, a node at each segment's start."""
+        x, first = loop_nodes(lengths, elements)
+        return cls(x, float(np.sum(lengths)), first)
+
+    @property
+    def n_elements(self) -> int:
+        """Number of elements N (= nodes)."""
+        return len(self.x)
+
+    @property
+    def he(self) -> np.ndarray:
+        """Element lengths (N)."""
+        return np.diff(np.append(self.x, self.loop_length))
+
+    @property
+    def h_min(self) -> float:
+        """The smallest element's length (m)."""
+        return float(self.he.min())
+
+
+def loop_mesh(grid: LoopGrid, contacts, mu: float, inertia: tuple[float, ...]) -> Mesh:
+    """A closed layout on a periodic grid (:class:`LoopGrid`, a node at each segment's
+    start).
+
+    contacts: for each contact, a
     tuple (segment index, radius, speed global) with speed global -1 for the driver (its
     rim speed prescribed) or the index of the free pulley's speed among the globals;
     mu: the friction coefficient of every arc (0: a constant bound, perfect adhesion);
@@ -49,10 +82,9 @@ def loop_mesh(lengths, contacts, elements: int, mu: float,
     Each arc's friction acts from its entry node to its exit node (the next segment's
     first), half volumes at both ends, as on the open layout's plate.
     """
-    x, first = loop_nodes(lengths, elements)
+    x, first, loop_length = grid.x, grid.first, grid.loop_length
     N = len(x)
-    loop_length = float(np.sum(lengths))
-    he = np.diff(np.append(x, loop_length))
+    he = grid.he
     hb = 0.5 * (he + np.roll(he, 1))
     seg = -np.ones(N, dtype=np.int64)
     wf = np.zeros(N)

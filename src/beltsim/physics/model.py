@@ -572,25 +572,37 @@ def loop_friction(w, i, j, s, m, k, dSe, dSc, S, inv_dt, c, hh, mesh, p, want_ja
 
 
 @njit(cache=True)
-def rate_part(e, a0, fs, sg, mesh, p, out):
-    """out = T e (both (n, 2)): T the time-derivative part of assemble's Jacobian at
+def rate_part(e, eg, a0, fs, sg, bs, c, mesh, p, out, outg):
+    """(out, outg) = T (e, eg): T the time-derivative part of assemble's Jacobian at
     inv_dt = a0, the terms in a0 (rate_blocks, and friction through the node's own
-    rate) with the friction slopes sg (N + 1) and the friction scale fs."""
+    rate) with the friction slopes sg and the friction scale fs (a loop's nodes: their
+    bounds bs), on the rows (e, out: (n, 2)) and a loop's globals (eg, outg: (ng)):
+    the belt's c_t in the axial rows and each free pulley's J omega_t. c: the belt speed."""
     he, hb, hh = mesh.he, mesh.hb, p.half_height
-    for i in range(e.shape[0]):
-        j = i + 1
-        du, lu, uu, dt_, lt, ut = rate_blocks(hb[j], he[j - 1], a0, p.speed, p)
-        ul = e[i - 1, 0] if i > 0 else 0.0
-        tl = e[i - 1, 1] if i > 0 else 0.0
-        ur = e[i + 1, 0] if i + 1 < e.shape[0] else 0.0
-        tr = e[i + 1, 1] if i + 1 < e.shape[0] else 0.0
+    off = mesh.off
+    n = e.shape[0]
+    for i in range(n):
+        j = i + off
+        jm = j - 1 if j > 0 else n - 1
+        du, lu, uu, dt_, lt, ut = rate_blocks(hb[j], he[jm], a0, c, p)
+        il = i - 1 if i > 0 else (n - 1 if off == 0 else -1)
+        ir = i + 1 if i + 1 < n else (0 if off == 0 else -1)
+        ul = e[il, 0] if il >= 0 else 0.0
+        tl = e[il, 1] if il >= 0 else 0.0
+        ur = e[ir, 0] if ir >= 0 else 0.0
+        tr = e[ir, 1] if ir >= 0 else 0.0
         out[i, 0] = du * e[i, 0] + lu * ul + uu * ur
         out[i, 1] = dt_ * e[i, 1] + lt * tl + ut * tr
         if mesh.seg[j] >= 0:
-            k = friction_stiffness(mesh.wf[j], fs, sg[j], p) * own_rate_slope(2, a0)
+            S = fs if off == 1 else bs[j]
+            k = friction_stiffness(mesh.wf[j], S, sg[j], p) * own_rate_slope(2, a0)
             eb = e[i, 0] + hh * e[i, 1]
             out[i, 0] += k * eb
             out[i, 1] += hh * k * eb
+        if off == 0:
+            out[i, 0] += p.mass * hb[j] * a0 * eg[0]
+    for k in range(eg.shape[0]):
+        outg[k] = mesh.inertia[k] * a0 * eg[k]
 
 
 @njit(cache=True)
@@ -702,33 +714,43 @@ POWER_TERMS = ("surface", "transport", "loads", "slip", "damping", "gyroscopic")
 
 @njit(cache=True)
 def power_terms(state, t, mesh, p, drive, loads, out):
-    """The five power terms of POWER_TERMS (W) of a state at time t, into ``out``."""
-    u, th, ud, td, F = state.u, state.theta, state.ud, state.td, state.fnode
-    he, hb, hh, c = mesh.he, mesh.hb, p.half_height, p.speed
+    """The six power terms of POWER_TERMS (W) of a state at time t, into ``out``.
+
+    On a loop (whose own balance adds the belt's and the pulleys' kinetic energy and the
+    driver's and the load's power) the terms are those of its rows, in the same form.
+    """
+    u, th, ud, td, F, g = state.u, state.theta, state.ud, state.td, state.fnode, state.g
+    he, hb, hh = mesh.he, mesh.hb, p.half_height
+    c = loop_speed(g, p)
     target = mismatch(drive, t)
+    rim = value(drive.speed, t)
     surface = 0.0
     transport = 0.0
     slip = 0.0
     for j in mesh.cn:
         strain_b = bottom_strain(u, th, hh, mesh.sw, j)
-        vrel = ud[j] + hh * td[j] + c * strain_b - target
-        surface += target * F[j]
+        tj = contact_target(mesh.seg[j], c, g, rim, target, mesh, p)
+        vrel = ud[j] + hh * td[j] + c * strain_b - tj
+        surface += tj * F[j]
         transport -= c * F[j] * strain_b
         slip -= F[j] * vrel
     damping = 0.0
     load = 0.0
+    gyro = 0.0
     lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
-    for j in range(1, u.shape[0] - 1):
+    nn = u.shape[0]
+    for i in range(nn - 2 * mesh.off):
+        j = i + mesh.off
+        jm = j - 1 if j > 0 else nn - 1
+        jp = j + 1 if j < nn - 1 else 0
         damping += p.damping * hb[j] * (p.mass * ud[j] * ud[j]
                                         + p.rotary_inertia * td[j] * td[j])
         if lk >= 0:
             load += hb[j] * (load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j) * ud[j]
                              + load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j) * td[j])
-    gyro = 0.0
-    for j in range(1, u.shape[0] - 1):
-        g0, gl, gu = gyro_weights(hb[j], he[j - 1], p.speed, p.gyro)
-        gyro += (p.mass * ud[j] * (g0 * ud[j] + gl * ud[j - 1] + gu * ud[j + 1])
-                 + p.rotary_inertia * td[j] * (g0 * td[j] + gl * td[j - 1] + gu * td[j + 1]))
+        g0, gl, gu = gyro_weights(hb[j], he[jm], c, p.gyro)
+        gyro += (p.mass * ud[j] * (g0 * ud[j] + gl * ud[jm] + gu * ud[jp])
+                 + p.rotary_inertia * td[j] * (g0 * td[j] + gl * td[jm] + gu * td[jp]))
     out[0], out[1], out[2], out[3], out[4], out[5] = (surface, transport, load, slip,
                                                       damping, gyro)
 

@@ -107,7 +107,7 @@ def friction_factor(drive, t):
     return value(drive.friction, t)
 
 
-def _profile(raw, offset: float, scale: float, ramp_time: float) -> Profile:
+def profile_of(raw, offset: float, scale: float, ramp_time: float) -> Profile:
     """(raw - offset) / scale as a Profile; numbers and sines ramp over ramp_time."""
     if isinstance(raw, list):
         rows = np.array(raw, dtype=float)
@@ -122,8 +122,8 @@ def drive_of(scene, ramp_time: float) -> Drive:
     """The scene's drive; ``ramp_time`` is the speed ramp (numerics.ramp_time)."""
     P = scene.params
     raw_speed, raw = _profiles(scene)
-    speed = _profile(raw_speed, P.c, 1.0, ramp_time)
-    friction = Profile.constant(1.0) if raw is None else _profile(raw, 0.0, P.fstar, 0.0)
+    speed = profile_of(raw_speed, P.c, 1.0, ramp_time)
+    friction = Profile.constant(1.0) if raw is None else profile_of(raw, 0.0, P.fstar, 0.0)
     return Drive(speed, friction)
 
 

@@ -8,11 +8,13 @@ from typing import ClassVar, NamedTuple
 
 import numpy as np
 
+from ..physics.friction import EXACT, LINEAR, has_dual
 from ..physics.grid import Grid
+from ..physics.layout import LoopGrid, loop_mesh, loop_params
 from ..physics.model import Loads, Mesh, ModelParams, State, mesh_of, model_params
-from ..problem.drive import drive_of
+from ..problem.drive import Drive, Profile, drive_of, profile_of
 from ..problem.scene import Scene
-from .settings import Numerics, build_grid, resolve
+from .settings import Numerics, build_grid, resolve, resolve_loop
 
 
 class Scales(NamedTuple):
@@ -57,9 +59,85 @@ class Discretisation:
     #: the layout's global unknowns (none on the open layout)
     n_globals = 0
 
+    #: an open layout's transport speed is the scene's c; a loop's is a global unknown
+    closed = False
+
     def new_state(self) -> State:
         """The belt at rest."""
         return State.zeros(len(self.mesh.hb), self.n_globals)
+
+    @property
+    def window(self) -> float:
+        """The layout's transit time (s): how long the material takes through it."""
+        return self.params.L / self.params.c
+
+    def steady_drive(self, s: float = 1.0) -> Drive:
+        """The drive of the steady problem, its final values; ``s`` scales the surface's
+        mismatch (the steady scheme's continuation)."""
+        return Drive.constant((self.params.v - self.params.c) * s)
+
+
+class LoopDiscretisation(Discretisation):
+    """A closed drive on its periodic grid: the loop layout (the driver's arc, the slack
+    span, the driven arc, the tight span), its two global unknowns (the belt speed c and
+    the driven pulley's speed omega_2) and the named structures the kernels read.
+
+    ``grid`` replaces the default grid (a :class:`~beltsim.physics.layout.LoopGrid`).
+    """
+
+    n_globals = 2
+    closed = True
+
+    def __init__(self, scene, grid: LoopGrid | None = None):
+        self.scene = scene
+        self.params = P = scene.params
+        num = resolve_loop(scene, None if grid is None else grid.n_elements)
+        self.numerics: Numerics = num
+        g = P.geometry
+        self.grid = grid if grid is not None else LoopGrid.build(g.lengths, num.elements)
+        self.mesh: Mesh = loop_mesh(self.grid, [(0, g.R1, -1), (2, g.R2, 1)],
+                                    0.0 if P.mu is None else P.mu, (0.0, P.J2))
+        code = num.law_code
+        self.model: ModelParams = loop_params(
+            a=P.a, b1=P.b1, b2=P.b2, rho=P.rho, I=P.I, lever=P.lever, damping=P.damping,
+            N0=P.N0, law=code, dual=int(has_dual(code) and code != LINEAR and code < EXACT),
+            regularisation=num.regularisation, friction_scale=num.friction_scale,
+            gyro=num.gyro_code)
+        d = scene.drive
+        # the rim speed omega_1(t) R_1 and the load M(t): numbers and sines ramp from 0
+        self.drive = Drive(profile_of(d["driver_speed"], 0.0, 1.0 / g.R1, num.ramp_time),
+                           Profile.constant(1.0),
+                           profile_of(d["load_torque"], 0.0, 1.0, num.ramp_time))
+        self.loads: Loads = Loads.none(self.grid.n_elements)
+        rim = P.omega1 * g.R1
+        strain = P.N0 / P.b1
+        L = g.loop_length
+        self.scales: Scales = Scales(P.N0, P.N0 * max(P.h, 1e-300), L * strain, strain,
+                                     np.array([rim, rim / g.R2]),
+                                     np.array([L * strain, P.N0 * g.R2]))
+
+    @property
+    def window(self) -> float:
+        return self.params.geometry.loop_length / (self.params.omega1
+                                                   * self.params.geometry.R1)
+
+    def steady_drive(self, s: float = 1.0) -> Drive:
+        """The final rim speed and load (``s`` is the open layout's continuation)."""
+        P = self.params
+        return Drive.constant(P.omega1 * P.geometry.R1, P.M2)
+
+    def with_grid(self, grid: LoopGrid) -> LoopDiscretisation:
+        """The same drive on another grid."""
+        return LoopDiscretisation(self.scene, grid)
+
+
+def discretise(scene, grid=None) -> Discretisation:
+    """A scene on its grid: a straight belt's open layout, or a closed drive's loop."""
+    from ..beltdrive.scene import DriveScene
+
+    if isinstance(scene, DriveScene):
+        return LoopDiscretisation(scene, grid)
+    return Discretisation(scene, grid)
 
 
 class Scheme:
@@ -77,6 +155,8 @@ class Scheme:
     #: whether numerics.acceleration (a damping that only speeds the approach) applies
     accelerated: ClassVar[bool] = False
     needs_inertia: ClassVar[bool] = False
+    #: whether it runs closed layouts (loops) too
+    closed: ClassVar[bool] = True
 
     def __init__(self, disc: Discretisation):
         self.disc = disc

@@ -38,10 +38,18 @@ import numpy as np
 from numba import njit
 
 from ..physics.friction import EXACT, LINEAR, RAMP, law
-from ..physics.model import LAM_MAX, assemble, bottom_strain, power_terms
-from ..problem.drive import friction_factor, mismatch
+from ..physics.model import (
+    LAM_MAX,
+    assemble,
+    bottom_strain,
+    contact_target,
+    loop_speed,
+    power_terms,
+)
+from ..problem.drive import friction_factor, mismatch, value
 from .implicit import (
     AdaptiveScheme,
+    copy_globals,
     copy_state,
     filtered_error,
     landing_step,
@@ -94,27 +102,36 @@ def initial_acceleration(state, base, t, mesh, p, drive, loads, w, au, at):
     friction ratios are first set from the state's slip velocities (a regularised law),
     or projected as the exact Coulomb law's iteration does (a sliding node then carries
     +-1; a sticking node's ratio and adhesion's are reactions and keep their values).
+    A loop's globals keep their rates (state.gd): the old globals are g - g_t.
     """
-    u, th, lam, ud, td = state.u, state.theta, state.lam, state.ud, state.td
-    N = u.shape[0] - 1
-    hh, c, code = p.half_height, p.speed, p.law
+    u, th, lam, ud, td, g = state.u, state.theta, state.lam, state.ud, state.td, state.g
+    nodes = u.shape[0]
+    off = mesh.off
+    hh, code = p.half_height, p.law
+    c = loop_speed(g, p)
     target = mismatch(drive, t)
-    for j in range(mesh.c0, mesh.j2 + 1):
-        vrel = ud[j] + hh * td[j] + c * bottom_strain(u, th, hh, mesh.sw, j) - target
+    rim = value(drive.speed, t)
+    for j in mesh.cn:
+        vrel = (ud[j] + hh * td[j] + c * bottom_strain(u, th, hh, mesh.sw, j)
+                - contact_target(mesh.seg[j], c, g, rim, target, mesh, p))
         s = vrel / p.regularisation
         if code == EXACT:
             lam[j] = min(1.0, max(-1.0, lam[j] + s))
         elif code < EXACT:
-            g = law(code, s)[0]
-            lam[j] = g if code == LINEAR or code == RAMP else min(LAM_MAX, max(-LAM_MAX, g))
-    for j in range(N + 1):
+            gr = law(code, s)[0]
+            lam[j] = gr if code == LINEAR or code == RAMP else min(LAM_MAX, max(-LAM_MAX, gr))
+    for j in range(nodes):
         base.u[j], base.theta[j] = u[j] - ud[j], th[j] - td[j]
         base.ud[j], base.td[j] = ud[j], td[j]
-    assemble(u, th, lam, state.g, state.fnode, base, 1.0, t, mesh, p, drive, loads, w, False)
-    au[0] = au[N] = at[0] = at[N] = 0.0
-    for j in range(1, N):
-        au[j] = -w.R[j - 1, 0] / (p.mass * mesh.hb[j]) if p.mass > 0.0 else 0.0
-        at[j] = (-w.R[j - 1, 1] / (p.rotary_inertia * mesh.hb[j])
+    for k in range(g.shape[0]):
+        base.g[k] = g[k] - state.gd[k]
+    assemble(u, th, lam, g, state.fnode, base, 1.0, t, mesh, p, drive, loads, w, False)
+    for j in range(nodes):
+        au[j] = at[j] = 0.0
+    for i in range(w.R.shape[0]):
+        j = i + off
+        au[j] = -w.R[i, 0] / (p.mass * mesh.hb[j]) if p.mass > 0.0 else 0.0
+        at[j] = (-w.R[i, 1] / (p.rotary_inertia * mesh.hb[j])
                  if p.rotary_inertia > 0.0 else 0.0)
 
 
@@ -123,7 +140,8 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
                    mesh, p, drive, loads, scales, settings, w, power, work):
     """Adaptive ESDIRK3(2)4L[2]SA steps from t until t_stop (reached exactly) or max_steps.
 
-    ``state`` holds u, theta, the friction unknowns and u_t, theta_t at t; ``rates`` the
+    ``state`` holds u, theta, the friction unknowns and u_t, theta_t at t (and a loop's
+    globals with their rates, the globals' first stage derivative); ``rates`` the
     accelerations at t and the friction ratios of the step before (h_prev = 0: there is
     none); ``base`` is workspace for the stages' old state (q~, v~); ``power`` holds the
     power terms at t (physics.model.POWER_TERMS) and ``work`` accumulates their
@@ -131,25 +149,35 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
     rejected).
     """
     u, th, lam, ud, td = state.u, state.theta, state.lam, state.ud, state.td
-    N = u.shape[0] - 1
+    g, gd = state.g, state.gd
+    nodes = u.shape[0]
+    off = mesh.off
+    n = w.R.shape[0]
+    ng = g.shape[0]
     steps = 0
     rejected = 0
-    u_n = np.empty(N + 1)
-    th_n = np.empty(N + 1)
-    ud_n = np.empty(N + 1)
-    td_n = np.empty(N + 1)
-    lam_n = np.empty(N + 1)
+    u_n = np.empty(nodes)
+    th_n = np.empty(nodes)
+    ud_n = np.empty(nodes)
+    td_n = np.empty(nodes)
+    lam_n = np.empty(nodes)
+    g_n = np.empty(ng)
+    gd_n = np.empty(ng)
     # the second stage's (u, theta, lam), for the later stages' predictor
-    u_2 = np.empty(N + 1)
-    th_2 = np.empty(N + 1)
-    lam_2 = np.empty(N + 1)
-    vu = np.zeros((4, N + 1))  # stage velocities and accelerations
-    vt = np.zeros((4, N + 1))
-    au = np.zeros((4, N + 1))
-    at = np.zeros((4, N + 1))
+    u_2 = np.empty(nodes)
+    th_2 = np.empty(nodes)
+    lam_2 = np.empty(nodes)
+    g_2 = np.empty(ng)
+    vu = np.zeros((4, nodes))  # stage velocities and accelerations
+    vt = np.zeros((4, nodes))
+    au = np.zeros((4, nodes))
+    at = np.zeros((4, nodes))
+    vg = np.zeros((4, ng))  # the globals' stage rates
     ps = np.empty((4, power.shape[0]))  # power terms at the stages
-    e = np.empty((N - 1, 2))
-    te = np.empty((N - 1, 2))
+    e = np.empty((n, 2))
+    te = np.empty((n, 2))
+    eg = np.empty(ng)
+    teg = np.empty(ng)
     while t < t_stop and steps < max_steps:
         remaining = t_stop - t
         if remaining <= 1e-9 * h_next:  # round-off of the caller's times, not a step
@@ -158,9 +186,12 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
         h, parts = landing_step(remaining, h_next, h_max)
         a0 = 1.0 / (GAMMA * h)
         copy_state(u_n, th_n, ud_n, td_n, lam_n, u, th, ud, td, lam)
-        for j in range(N + 1):
+        copy_globals(g_n, gd_n, g, gd)
+        for j in range(nodes):
             vu[0, j], vt[0, j] = ud[j], td[j]
             au[0, j], at[0, j] = rates.au[j], rates.at[j]
+        for k in range(ng):
+            vg[0, k] = gd[k]
         for k in range(power.shape[0]):
             ps[0, k] = power[k]
         ok = True
@@ -174,19 +205,24 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
                 c0_, c1_, c2_ = A31, A32, 0.0
             else:
                 c0_, c1_, c2_ = B1, B2, B3
-            for j in range(N + 1):
+            for j in range(nodes):
                 base.u[j] = u_n[j] + h * (c0_ * vu[0, j] + c1_ * vu[1, j] + c2_ * vu[2, j])
                 base.theta[j] = th_n[j] + h * (c0_ * vt[0, j] + c1_ * vt[1, j]
                                                + c2_ * vt[2, j])
                 base.ud[j] = ud_n[j] + h * (c0_ * au[0, j] + c1_ * au[1, j] + c2_ * au[2, j])
                 base.td[j] = td_n[j] + h * (c0_ * at[0, j] + c1_ * at[1, j] + c2_ * at[2, j])
+            for k in range(ng):
+                base.g[k] = g_n[k] + h * (c0_ * vg[0, k] + c1_ * vg[1, k] + c2_ * vg[2, k])
             # predictor: Taylor at the second stage; the cubic through (q_n, v_n) and the
             # second stage's (q, v) after it. Friction ratios: linear in time.
             s = ci * h
             if i == 1:
-                for j in range(1, N):
+                for r in range(n):
+                    j = r + off
                     u[j] = u_n[j] + s * ud_n[j] + 0.5 * s * s * au[0, j]
                     th[j] = th_n[j] + s * td_n[j] + 0.5 * s * s * at[0, j]
+                for k in range(ng):
+                    g[k] = g_n[k] + s * gd_n[k]
                 if h_prev > 0.0:
                     predict_friction(lam, rates.lam_prev, s / h_prev, mesh, p.law)
             else:
@@ -196,16 +232,19 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
                 h10 = x * (1.0 - x) * (1.0 - x) * s1
                 h01 = x * x * (3.0 - 2.0 * x)
                 h11 = x * x * (x - 1.0) * s1
-                for j in range(1, N):
+                for r in range(n):
+                    j = r + off
                     u[j] = h00 * u_n[j] + h10 * ud_n[j] + h01 * u_2[j] + h11 * vu[1, j]
                     th[j] = h00 * th_n[j] + h10 * td_n[j] + h01 * th_2[j] + h11 * vt[1, j]
-                for j in range(N + 1):
+                for k in range(ng):
+                    g[k] = h00 * g_n[k] + h10 * gd_n[k] + h01 * g_2[k] + h11 * vg[1, k]
+                for j in range(nodes):
                     lam[j] = lam_2[j]
                 predict_friction(lam, lam_n, x - 1.0, mesh, p.law)
             ok = newton(state, base, a0, t + s, mesh, p, drive, loads, scales, settings, w)
             if not ok:
                 break
-            for j in range(N + 1):
+            for j in range(nodes):
                 vu[i, j] = a0 * (u[j] - base.u[j])
                 vt[i, j] = a0 * (th[j] - base.theta[j])
                 au[i, j] = a0 * (vu[i, j] - base.ud[j])
@@ -213,31 +252,42 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
                 ud[j], td[j] = vu[i, j], vt[i, j]
                 if not (np.isfinite(u[j]) and np.isfinite(th[j])):
                     finite = False
+            for k in range(ng):
+                vg[i, k] = a0 * (g[k] - base.g[k])
+                gd[k] = vg[i, k]
+                if not np.isfinite(g[k]):
+                    finite = False
             if not finite:
                 break
             if i == 1:
-                for j in range(N + 1):
+                for j in range(nodes):
                     u_2[j], th_2[j], lam_2[j] = u[j], th[j], lam[j]
+                for k in range(ng):
+                    g_2[k] = g[k]
             power_terms(state, t + s, mesh, p, drive, loads, ps[i])
         if ok and not finite:
-            for j in range(N + 1):
-                u[j], th[j], ud[j], td[j], lam[j] = u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j]
+            copy_state(u, th, ud, td, lam, u_n, th_n, ud_n, td_n, lam_n)
+            copy_globals(g, gd, g_n, gd_n)
             return NONFINITE, t, h_prev, h_next, steps, rejected
         err = 0.0
         if ok:
             d0, d1, d2, d3 = B1 - E1, B2 - E2, B3 - E3, B4 - E4
-            for r in range(N - 1):
-                j = r + 1
+            for r in range(n):
+                j = r + off
                 e[r, 0] = h * (d0 * vu[0, j] + d1 * vu[1, j] + d2 * vu[2, j] + d3 * vu[3, j])
                 e[r, 1] = h * (d0 * vt[0, j] + d1 * vt[1, j] + d2 * vt[2, j] + d3 * vt[3, j])
-            filtered_error(e, a0, p.friction_scale * friction_factor(drive, t + h), mesh, p, w,
-                           te)
-            for r in range(N - 1):
+            for k in range(ng):
+                eg[k] = h * (d0 * vg[0, k] + d1 * vg[1, k] + d2 * vg[2, k] + d3 * vg[3, k])
+            filtered_error(e, eg, a0, p.friction_scale * friction_factor(drive, t + h),
+                           loop_speed(g, p), mesh, p, w, te, teg)
+            for r in range(n):
                 err = max(err, abs(e[r, 0]) / scales.u, abs(e[r, 1]) / scales.theta)
+            for k in range(ng):
+                err = max(err, abs(eg[k]) / scales.glob[k])
             if not math.isfinite(err):
                 err = np.inf
         if ok and err <= tol:
-            for j in range(N + 1):
+            for j in range(nodes):
                 rates.au[j], rates.at[j] = au[3, j], at[3, j]
                 rates.lam_prev[j] = lam_n[j]
             t = t_stop if parts == 1 else t + h  # the last part lands on t_stop exactly
@@ -252,6 +302,7 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
         rejected += 1
         w.stats[0].failed_steps += 1
         copy_state(u, th, ud, td, lam, u_n, th_n, ud_n, td_n, lam_n)
+        copy_globals(g, gd, g_n, gd_n)
         h_next = h * step_factor(err, tol, ok, MAX_GROWTH)
         if h_next < h_min:
             return FAILED, t, h_prev, h_next, steps, rejected
@@ -267,7 +318,7 @@ class EsdirkScheme(AdaptiveScheme):
 
     def __init__(self, disc):
         super().__init__(disc)
-        self.rates = Rates.zeros(disc.grid.n_elements + 1)
+        self.rates = Rates.zeros(len(disc.mesh.hb))
         self.started = False  # whether rates.au, rates.at hold the state's accelerations
 
     def advance(self, state, t, t_stop, max_steps=10**9):

@@ -652,6 +652,7 @@ class ExplicitScheme(Scheme):
     of the von Neumann limit (inertial scenes)."""
 
     name = "explicit"
+    closed = False  # open layouts only, for now
     needs_inertia = True
 
     def __init__(self, disc):

@@ -38,9 +38,9 @@ import numpy as np
 from numba import njit
 
 from ..physics.friction import EXACT
-from ..physics.model import LAM_MAX, POWER_TERMS, power_terms, rate_part
+from ..physics.model import LAM_MAX, POWER_TERMS, loop_speed, power_terms, rate_part
 from ..problem.drive import friction_factor
-from .newton import FAILED, NONFINITE, OK, NewtonScheme, block_substitute, newton
+from .newton import FAILED, NONFINITE, OK, NewtonScheme, linear_solve, newton
 from .registry import register
 
 SAFETY = 0.8
@@ -71,6 +71,13 @@ def copy_state(u, th, ud, td, lam, u_n, th_n, ud_n, td_n, lam_n):
 
 
 @njit(cache=True)
+def copy_globals(g, gd, g_n, gd_n):
+    """(g, gd) = (g_n, gd_n): a loop's global unknowns and their rates."""
+    for k in range(g.shape[0]):
+        g[k], gd[k] = g_n[k], gd_n[k]
+
+
+@njit(cache=True)
 def landing_step(remaining, h_next, h_max):
     """The step that ends on the stop time: the remaining span in equal parts of at most
     min(h_next, h_max)."""
@@ -88,24 +95,28 @@ class History(NamedTuple):
     au: np.ndarray  # u_tt, theta_tt at t_n
     at: np.ndarray
     lam: np.ndarray  # the friction unknowns at t_{n-1} (the Newton predictor's)
+    g: np.ndarray = np.zeros(0)  # a loop's globals and their rates at t_{n-1}
+    gd: np.ndarray = np.zeros(0)
 
     @classmethod
-    def zeros(cls, n_nodes):
-        """All zero on ``n_nodes`` nodes."""
-        return cls(*(np.zeros(n_nodes) for _ in cls._fields))
+    def zeros(cls, n_nodes, n_globals=0):
+        """All zero on ``n_nodes`` nodes with ``n_globals`` globals."""
+        return cls(*(np.zeros(n_nodes) for _ in range(7)), np.zeros(n_globals),
+                   np.zeros(n_globals))
 
 
 @njit(cache=True)
-def filtered_error(e, a0, fs, mesh, p, w, out):
-    """Solve J e_f = T e in place of ``e`` (n, 2); J: the step's Newton matrix, T: its a0 part.
+def filtered_error(e, eg, a0, fs, c, mesh, p, w, out, outg):
+    """Solve J e_f = T e in place of ``e`` (n, 2) and a loop's ``eg`` (ng); J: the step's
+    Newton matrix, T: its a0 part.
 
     J is applied through the block LU the Newton solve left in ``w``, T
     (:func:`beltsim.physics.model.rate_part`) takes the friction slopes of that J
-    (w.sgf); fs: the friction scale at the step's time (f* times the profile's factor).
-    ``out`` receives T e.
+    (w.sgf); fs: the friction scale at the step's time (f* times the profile's factor),
+    c the belt speed. ``out`` (and ``outg``) receive T e.
     """
-    rate_part(e, a0, fs, w.sgf, mesh, p, out)
-    block_substitute(w, out, e)
+    rate_part(e, eg, a0, fs, w.sgf, w.bs, c, mesh, p, out, outg)
+    linear_solve(w, mesh, out, outg, e, eg)
 
 
 @njit(cache=True)
@@ -121,7 +132,7 @@ def predict_friction(lam, lam_prev, r, mesh, code):
     iterations where the slip front moves fast.
     """
     bound = math.inf if code >= EXACT else LAM_MAX
-    for j in range(mesh.c0, mesh.j2 + 1):
+    for j in mesh.cn:
         lam[j] = min(bound, max(-bound, lam[j] + r * (lam[j] - lam_prev[j])))
 
 
@@ -130,27 +141,37 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
                  mesh, p, drive, loads, scales, settings, w, power, work):
     """Adaptive BDF2 steps from t until t_stop (reached exactly) or max_steps.
 
-    ``state`` holds u, theta, the friction unknowns and u_t, theta_t at t; ``hist``
-    the previous step (h_prev = 0: there is none, the next step is backward Euler);
-    ``base`` is workspace for y*; ``power`` holds the power terms at t
-    (physics.model.POWER_TERMS) and ``work`` accumulates their integrals over the
-    accepted steps (trapezoidal rule, second order like the scheme). Returns
-    (status, t, h_prev, h_next, steps, rejected).
+    ``state`` holds u, theta, the friction unknowns and u_t, theta_t at t (and a loop's
+    globals with their rates); ``hist`` the previous step (h_prev = 0: there is none,
+    the next step is backward Euler); ``base`` is workspace for y*; ``power`` holds the
+    power terms at t (physics.model.POWER_TERMS) and ``work`` accumulates their
+    integrals over the accepted steps (trapezoidal rule, second order like the scheme).
+    A loop's globals are first-order unknowns: their local error (2/9) h^3 g^(3) comes
+    from the change of their rates over the last two steps. Returns (status, t, h_prev,
+    h_next, steps, rejected).
     """
     u, th, lam, ud, td = state.u, state.theta, state.lam, state.ud, state.td
-    N = u.shape[0] - 1
+    g, gd = state.g, state.gd
+    nodes = u.shape[0]
+    off = mesh.off
+    n = w.R.shape[0]
+    ng = g.shape[0]
     steps = 0
     rejected = 0
-    u_n = np.empty(N + 1)
-    th_n = np.empty(N + 1)
-    ud_n = np.empty(N + 1)
-    td_n = np.empty(N + 1)
-    lam_n = np.empty(N + 1)
-    au_new = np.empty(N + 1)
-    at_new = np.empty(N + 1)
+    u_n = np.empty(nodes)
+    th_n = np.empty(nodes)
+    ud_n = np.empty(nodes)
+    td_n = np.empty(nodes)
+    lam_n = np.empty(nodes)
+    g_n = np.empty(ng)
+    gd_n = np.empty(ng)
+    au_new = np.empty(nodes)
+    at_new = np.empty(nodes)
     p_new = np.empty(power.shape[0])
-    e = np.empty((N - 1, 2))
-    te = np.empty((N - 1, 2))
+    e = np.empty((n, 2))
+    te = np.empty((n, 2))
+    eg = np.empty(ng)
+    teg = np.empty(ng)
     while t < t_stop and steps < max_steps:
         remaining = t_stop - t
         if remaining <= 1e-9 * h_next:  # round-off of the caller's times, not a step
@@ -158,59 +179,81 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
             break
         h, parts = landing_step(remaining, h_next, h_max)
         copy_state(u_n, th_n, ud_n, td_n, lam_n, u, th, ud, td, lam)
+        copy_globals(g_n, gd_n, g, gd)
         if h_prev > 0.0:
             r = h / h_prev
             a0 = (1.0 + 2.0 * r) / ((1.0 + r) * h)
             cn = (1.0 + r) * (1.0 + r) / (1.0 + 2.0 * r)
             cp = r * r / (1.0 + 2.0 * r)
-            for j in range(N + 1):
+            for j in range(nodes):
                 base.u[j] = cn * u_n[j] - cp * hist.u[j]
                 base.theta[j] = cn * th_n[j] - cp * hist.theta[j]
                 base.ud[j] = cn * ud_n[j] - cp * hist.ud[j]
                 base.td[j] = cn * td_n[j] - cp * hist.td[j]
+            for k in range(ng):
+                base.g[k] = cn * g_n[k] - cp * hist.g[k]
             err_const = BDF2_ERROR
         else:
             a0 = 1.0 / h
-            for j in range(N + 1):
+            for j in range(nodes):
                 base.u[j], base.theta[j] = u_n[j], th_n[j]
                 base.ud[j], base.td[j] = ud_n[j], td_n[j]
+            for k in range(ng):
+                base.g[k] = g_n[k]
             err_const = 0.5
         # predictor: second-order Taylor step with the current accelerations
-        for j in range(1, N):
+        for i in range(n):
+            j = i + off
             u[j] = u_n[j] + h * ud_n[j] + 0.5 * h * h * hist.au[j]
             th[j] = th_n[j] + h * td_n[j] + 0.5 * h * h * hist.at[j]
+        for k in range(ng):
+            g[k] = g_n[k] + h * gd_n[k]
         if h_prev > 0.0:
             predict_friction(lam, hist.lam, h / h_prev, mesh, p.law)
         ok = newton(state, base, a0, t + h, mesh, p, drive, loads, scales, settings, w)
         err = 0.0
         finite = True
         if ok:
-            for j in range(N + 1):
+            for j in range(nodes):
                 ud[j] = a0 * (u[j] - base.u[j])
                 td[j] = a0 * (th[j] - base.theta[j])
                 au_new[j] = a0 * (ud[j] - base.ud[j])
                 at_new[j] = a0 * (td[j] - base.td[j])
                 if not (np.isfinite(u[j]) and np.isfinite(th[j])):
                     finite = False
-            for i in range(N - 1):
-                e[i, 0] = err_const * h * h * (au_new[i + 1] - hist.au[i + 1])
-                e[i, 1] = err_const * h * h * (at_new[i + 1] - hist.at[i + 1])
-            filtered_error(e, a0, p.friction_scale * friction_factor(drive, t + h), mesh, p, w,
-                           te)
-            for i in range(N - 1):
+            for k in range(ng):
+                gd[k] = a0 * (g[k] - base.g[k])
+                if not np.isfinite(g[k]):
+                    finite = False
+                # the third derivative from the rates at t_{n-1}, t_n, t_{n+1}
+                eg[k] = 0.0
+                if h_prev > 0.0:
+                    g3 = ((gd[k] - gd_n[k]) / h - (gd_n[k] - hist.gd[k]) / h_prev) \
+                        / (0.5 * (h + h_prev))
+                    eg[k] = err_const * h * h * h * g3
+            for i in range(n):
+                j = i + off
+                e[i, 0] = err_const * h * h * (au_new[j] - hist.au[j])
+                e[i, 1] = err_const * h * h * (at_new[j] - hist.at[j])
+            filtered_error(e, eg, a0, p.friction_scale * friction_factor(drive, t + h),
+                           loop_speed(g, p), mesh, p, w, te, teg)
+            for i in range(n):
                 err = max(err, abs(e[i, 0]) / scales.u, abs(e[i, 1]) / scales.theta)
+            for k in range(ng):
+                err = max(err, abs(eg[k]) / scales.glob[k])
             if not math.isfinite(err):
                 err = np.inf
         if ok and not finite:
-            for j in range(N + 1):
-                u[j], th[j], ud[j], td[j], lam[j] = u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j]
+            copy_state(u, th, ud, td, lam, u_n, th_n, ud_n, td_n, lam_n)
+            copy_globals(g, gd, g_n, gd_n)
             return NONFINITE, t, h_prev, h_next, steps, rejected
         if ok and err <= tol:
-            for j in range(N + 1):
+            for j in range(nodes):
                 hist.u[j], hist.theta[j] = u_n[j], th_n[j]
                 hist.ud[j], hist.td[j] = ud_n[j], td_n[j]
                 hist.au[j], hist.at[j] = au_new[j], at_new[j]
                 hist.lam[j] = lam_n[j]
+            copy_globals(hist.g, hist.gd, g_n, gd_n)
             t = t_stop if parts == 1 else t + h  # the last part lands on t_stop exactly
             steps += 1
             h_prev = h
@@ -224,6 +267,7 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
         rejected += 1
         w.stats[0].failed_steps += 1
         copy_state(u, th, ud, td, lam, u_n, th_n, ud_n, td_n, lam_n)
+        copy_globals(g, gd, g_n, gd_n)
         h_next = h * step_factor(err, tol, ok, MAX_GROWTH)
         if h_next < h_min:
             return FAILED, t, h_prev, h_next, steps, rejected
@@ -267,7 +311,7 @@ class ImplicitScheme(AdaptiveScheme):
 
     def __init__(self, disc):
         super().__init__(disc)
-        self.hist = History.zeros(disc.grid.n_elements + 1)
+        self.hist = History.zeros(len(disc.mesh.hb), disc.n_globals)
 
     def advance(self, state, t, t_stop, max_steps=10**9):
         d, num = self.disc, self.numerics

@@ -40,6 +40,8 @@ ROUNDOFF_FLOOR = 1e3
 # is estimated as rate / (1 - rate) times the update: Newton stops when that is below
 # tol, one iteration before the update itself would be
 CONTRACTION = 0.5
+# A scaled residual of root mean square below 1e-13 per row is at round-off
+ROUNDOFF_MERIT = 1e-26
 # A friction ratio with slope dlam/ds below NEAR_BOUND (|lam| > 0.995 for tanh) that
 # differs from the law at its slip velocity by more than LAW_GAP is stuck at the bound
 NEAR_BOUND = 1e-2
@@ -439,7 +441,10 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
         assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
         changed = saddle_system(lam, loop_speed(g, p), inv_dt, fs, mesh, p, w, s)
         update = max(step, dlam)
-        done = changed == 0 and update_converged(update, previous, it, tol)
+        # a front node may flip between stick and slip at round-off: a residual at its
+        # floor ends the iteration whatever the pattern did
+        settled = changed == 0 or merit(w.R, w.Rg, scales) < ROUNDOFF_MERIT * (n + ng)
+        done = settled and update_converged(update, previous, it, tol)
         previous = update
         if done:
             project(lam, mesh, p.law)  # the sliding ratios, off +-1 by round-off

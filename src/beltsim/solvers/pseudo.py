@@ -79,6 +79,7 @@ class PseudoScheme(NewtonScheme):
     """Backward Euler with step cutting on Newton failure; not time-accurate."""
 
     name = "pseudo"
+    closed = False  # open layouts only, for now
     time_accurate = False
     accelerated = True
 

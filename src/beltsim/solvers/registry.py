@@ -35,10 +35,14 @@ def get(name: str) -> type:
                          f"{' | '.join(repr(n) for n in _REGISTRY)}, got {name!r}") from None
 
 
-def applicable(name: str, inertia: bool) -> str | None:
-    """Why a scheme does not apply to a scene (None when it does)."""
+def applicable(name: str, inertia: bool, closed: bool = False) -> str | None:
+    """Why a scheme does not apply to a scene (None when it does); ``closed``: a loop."""
     cls = get(name)
     if cls.needs_inertia and not inertia:
         return (f'numerics.integrator: "{name}" needs physics.inertia = true (a quasistatic '
                 f'scene has no dynamics to step explicitly)')
+    if closed and not cls.closed:
+        usable = " | ".join(f'"{n}"' for n, c in _REGISTRY.items() if c.closed)
+        return (f'numerics.integrator: "{name}" does not run a closed drive yet (one of '
+                f'{usable})')
     return None

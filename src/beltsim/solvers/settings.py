@@ -233,3 +233,54 @@ def expected_slip_start(scene: Scene) -> tuple:
     except analytic.NoSolutionError:
         return ()
     return () if x_star is None or x_star >= P.x2 else (float(x_star),)
+
+
+#: A loop's default elements, and its regularised laws' default v_reg in units of the
+#: creep speed (sharper ones stall Newton; the exact law, the default, has none)
+LOOP_ELEMENTS = 800
+LOOP_REGULARISATION = 0.1
+
+
+def resolve_loop(scene, elements: int | None = None) -> Numerics:
+    """A closed drive's numerical settings with their defaults (the same keys and
+    meanings as an open layout's; the scales are the loop's: its transit time, the creep
+    speed omega_1 R_1 N0 / b1 of the slip velocities)."""
+    from ..beltdrive.analytic import creep_speed, transit_time
+
+    P, nm = scene.params, scene.numerics
+    if elements is None:
+        elements = nm.get("elements", LOOP_ELEMENTS)
+    check_memory(elements)
+    integrator = nm.get("integrator", DEFAULT_INTEGRATOR)
+    reason = registry.applicable(integrator, P.inertia, closed=True)
+    if reason:
+        raise SceneError(reason)
+    transit = transit_time(P)
+    ramp_time = nm.get("ramp_time", 2.0 * transit)
+    settle = max([ramp_time, *(v[-1][0] for v in (scene.drive["driver_speed"],
+                                                  scene.drive["load_torque"])
+                               if isinstance(v, list))])
+    dt = nm.get("dt", transit / 4.0)
+    t_end = nm.get("t_end", settle + 40.0 * transit)
+    if dt > t_end:
+        raise SceneError("numerics.dt", f"must be <= numerics.t_end = {t_end!r}, got {dt!r}")
+    creep = creep_speed(P)
+    friction_scale = 1.0
+    if P.mu is None:
+        # adhesion's reaction, scaled as the pretension's pressure on the driver
+        law, regularisation = "adhesion", creep
+        friction_scale = P.N0 / P.geometry.R1
+    else:
+        law = nm.get("friction_law", "exact")
+        regularisation = (creep if law == "exact" else
+                          nm.get("regularisation", LOOP_REGULARISATION * creep))
+    return Numerics(
+        integrator=integrator, elements=elements, grading=1.0, dt=dt, t_end=t_end,
+        ramp_time=ramp_time, friction_law=law, regularisation=regularisation,
+        friction_scale=friction_scale, acceleration=0.0,
+        steady_tol=nm.get("steady_tol", 1e-7),
+        snapshot_interval=nm.get("snapshot_interval"),
+        newton_tol=nm.get("newton_tol", 1e-10),
+        newton_max_iterations=nm.get("newton_max_iterations", 40),
+        time_tol=nm.get("time_tol", TIME_TOLS.get(integrator, DEFAULT_TIME_TOL)),
+        settle_time=settle, gyroscopic=nm.get("gyroscopic", "upwind"))

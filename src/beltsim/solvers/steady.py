@@ -23,14 +23,15 @@ import copy
 
 import numpy as np
 
+from ..beltdrive.analytic import creep_speed, solve_string
 from ..errors import FailureKind, NumericalError
-from ..physics.friction import is_exact
+from ..physics.friction import EXACT, TANH, is_exact
 from ..physics.grid import Grid
+from ..physics.layout import LoopGrid
 from ..physics.model import Loads, mesh_of, regularised
-from ..problem.drive import Drive
 from .newton import NewtonScheme, NewtonSettings, newton
 from .registry import register
-from .settings import default_elements
+from .settings import LOOP_ELEMENTS, LOOP_REGULARISATION, default_elements
 
 MIN_STAGE = 1e-6  # smallest continuation stage, relative to the full mismatch
 STAGE_ITERATIONS = 4  # Newton iterations per stage, in units of newton_max_iterations
@@ -57,7 +58,7 @@ class SteadyScheme(NewtonScheme):
 
     def _stage(self, state, s, settings):
         d = self.disc
-        drive = Drive.constant((d.params.v - d.params.c) * s)
+        drive = d.steady_drive(s)
         return newton(state, self.old, 0.0, 0.0, d.mesh, d.model, drive, d.loads, d.scales,
                       settings, self.work)
 
@@ -83,6 +84,9 @@ class SteadyScheme(NewtonScheme):
         grids so fine that its update stalls above its round-off floor).
         """
         d = self.disc
+        if d.closed:
+            self._solve_loop(state)
+            return
         if d.grid.n_elements <= COARSEST * default_elements(d.params):
             self._solve_from_rest(state)
             self.grid_iterations = [int(self.work.stats[0]["newton_iterations"])]
@@ -136,6 +140,62 @@ class SteadyScheme(NewtonScheme):
                     "converge from its regularised twin's steady state",
                     kind=FailureKind.CONTINUATION, t=0.0, quantity="newton")
 
+    def _solve_loop(self, state) -> None:
+        """A loop's steady state: Newton from the creep theory's (the extensible string's
+        exact steady state, theta = 0) on grids up to COARSEST times the default
+        elements, else from the steady state of a grid COARSENING times coarser. Exact
+        Coulomb friction first solves its regularised twin (tanh at LOOP_REGULARISATION
+        times the creep speed) from there: the semi-smooth Newton from the string's
+        state, whose slip fronts the beam moves, cycles between stick and slip at the
+        fronts; a sharp regularised law comes down to its v_reg from the creep speed in
+        steps of ten."""
+        d = self.disc
+        model = d.model
+        if d.grid.n_elements > COARSEST * LOOP_ELEMENTS:
+            coarse = d.with_grid(LoopGrid.build(d.params.geometry.lengths,
+                                                d.grid.n_elements // COARSENING))
+            level = SteadyScheme(coarse)
+            coarse_state = coarse.new_state()
+            level.solve(coarse_state)
+            self.steps += level.steps
+            stats, level_stats = self.work.stats[0], level.work.stats[0]
+            for key in ("newton_iterations", "line_search_cuts"):
+                stats[key] += level_stats[key]
+            before = int(stats["newton_iterations"])
+            interpolate_loop(coarse.grid, coarse_state, d.grid, d.mesh.cn, state)
+            self._loop_stage(state, model, "from the steady state of "
+                             f"{coarse.grid.n_elements} elements")
+            self.grid_iterations = [*level.grid_iterations,
+                                    int(stats["newton_iterations"]) - before]
+            return
+        creep_state(d, state)
+        creep = creep_speed(d.params)
+        try:
+            if model.law == EXACT:
+                twin = model._replace(law=TANH, dual=1,
+                                      regularisation=LOOP_REGULARISATION * creep)
+                self.disc.model = twin
+                self._loop_stage(state, twin, "of the regularised twin")
+            elif model.law < EXACT:
+                v = creep
+                while v > 10.0 * model.regularisation:
+                    self.disc.model = model._replace(regularisation=v)
+                    self._loop_stage(state, self.disc.model, f"at v_reg = {v:.3g} m/s")
+                    v /= 10.0
+        finally:
+            self.disc.model = model
+        self._loop_stage(state, model, "from the creep theory's state")
+        self.grid_iterations = [int(self.work.stats[0]["newton_iterations"])]
+
+    def _loop_stage(self, state, model, what) -> None:
+        # the twin's regularised law needs the regularised workspace's arrays only
+        self.steps += 1
+        if not self._stage(state, 1.0, self._stage_settings):
+            raise NumericalError(
+                f"steady Newton iteration on {self.disc.grid.n_elements} elements did not "
+                f"converge {what} (residual norm {self.work.stats[0]['merit']:.3g})",
+                kind=FailureKind.CONTINUATION, t=0.0, quantity="newton")
+
     def _continue_in_speed(self, state) -> None:
         stage_settings = self._stage_settings
         s_done, ds = 0.0, 1.0
@@ -183,3 +243,37 @@ def interpolate(coarse: Grid, state, fine: Grid, out) -> None:
     out.theta[:] = np.interp(fine.x, coarse.x, state.theta)
     cc, cf = slice(coarse.j1, coarse.j2 + 1), slice(fine.j1, fine.j2 + 1)
     out.lam[cf] = np.interp(fine.x[cf], coarse.x[cc], state.lam[cc])
+
+
+def creep_state(d, state) -> None:
+    """A loop's state at the creep theory's steady state (the extensible string's exact
+    one; theta = 0): Newton's start. Raises NoSolutionError where the string has none
+    (gross slip, lift-off)."""
+    sol = solve_string(d.params)
+    P, x = d.params, d.grid.x
+    state.assign(type(state).zeros(len(x), d.n_globals))
+    state.u[:] = sol.displacement(x)
+    cn = d.mesh.cn
+    if P.mu is not None:
+        p = sol.pressure(x[cn])
+        lam = np.where(p > 0, -sol.friction(x[cn]) / (P.mu * np.where(p > 0, p, 1.0)), 0.0)
+        # inside (-1, 1): the regularised laws' inverse is singular on the boundary
+        state.lam[cn] = np.clip(lam, -1.0 + 1e-9, 1.0 - 1e-9)
+    else:
+        state.lam[cn] = -sol.friction(x[cn]) / d.model.friction_scale
+    state.g[:] = (sol.c, sol.omega2)
+
+
+def interpolate_loop(coarse, state, fine, contact, out) -> None:
+    """A coarse loop's steady state on a finer grid: u, theta and the friction ratios
+    (on the fine grid's ``contact`` nodes) linear in x, periodic; the globals as they
+    are."""
+    out.assign(type(out).zeros(fine.n_elements, len(state.g)))
+    xc = np.append(coarse.x, coarse.loop_length)
+    for name in ("u", "theta", "lam"):
+        v = getattr(state, name)
+        getattr(out, name)[:] = np.interp(fine.x, xc, np.append(v, v[0]))
+    off = np.ones(len(fine.x), bool)
+    off[contact] = False
+    out.lam[off] = 0.0
+    out.g[:] = state.g
