@@ -337,9 +337,9 @@ def friction_stiffness(wfj, fs, sgj, p):
 
 
 @njit(cache=True, inline="always")
-def loop_speed(g, p):
+def loop_speed(g, mesh, p):
     """The belt speed c: a loop's first global unknown, or the open layout's constant."""
-    return g[0] if g.shape[0] > 0 else p.speed
+    return g[0] if mesh.off == 0 else p.speed
 
 
 @njit(cache=True, inline="always")
@@ -405,7 +405,7 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
     closed = off == 0
     n = nn - 2 * off
     rho, I, hh = p.mass, p.rotary_inertia, p.half_height
-    c = loop_speed(g, p)
+    c = loop_speed(g, mesh, p)
     if closed:
         B, A = p.b1 - rho * c * c, p.a - I * c * c
         cd = (c - old.g[0]) * inv_dt
@@ -721,7 +721,7 @@ def power_terms(state, t, mesh, p, drive, loads, out):
     """
     u, th, ud, td, F, g = state.u, state.theta, state.ud, state.td, state.fnode, state.g
     he, hb, hh = mesh.he, mesh.hb, p.half_height
-    c = loop_speed(g, p)
+    c = loop_speed(g, mesh, p)
     target = mismatch(drive, t)
     rim = value(drive.speed, t)
     surface = 0.0

@@ -128,7 +128,11 @@ def drive_of(scene, ramp_time: float) -> Drive:
 
 
 def _profiles(scene):
+    """The scene's two profiles: the surface speed and the friction limit of the paper's
+    belt, a drive's driver speed and load."""
     data = scene.to_dict()
+    if "drive" in data:
+        return data["drive"]["driver_speed"], data["drive"]["load_torque"]
     return data["motion"]["surface_speed"], data["contact"].get("max_friction")
 
 

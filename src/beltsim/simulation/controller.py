@@ -15,18 +15,18 @@ import time
 import numpy as np
 
 from .. import solvers
-from ..errors import NumericalError, UsageError
+from ..errors import NumericalError
 from ..physics.grid import Grid
-from ..problem.drive import mismatch as mismatch_at
 from ..problem.drive import period_of, profile_times
 from ..problem.scene import Scene
+from .readout import readout_of
 from .result import RunResult, RunStatus
-from .solution import DiscreteSolution
 from .trackers import (
     CallbackTracker,
     CheckpointTracker,
     DivergenceGuard,
     HistoryTracker,
+    OutcomeTracker,
     PeriodicTracker,
     PowerBalanceTracker,
     ProgressTracker,
@@ -72,35 +72,38 @@ class Simulation:
 
     def __init__(self, scene: Scene, grid: Grid | None = None,
                  snapshot_interval: float | None = None, loads=None):
-        self.disc = solvers.Discretisation(scene, grid)
+        self.disc = solvers.discretise(scene, grid)
         if loads is not None:  # distributed loads (physics.model.Loads) on this grid
             self.disc.loads = loads
+        self.readout = readout_of(self.disc)
         self.scheme = solvers.get(self.disc.numerics.integrator)(self.disc)
         self.state = self.disc.new_state()
         self.t = 0.0
         self.wall_time = 0.0
-        P, num = self.disc.params, self.numerics
-        window = P.L / P.c
+        num = self.numerics
+        window = self.disc.window
         self.snapshot_interval = snapshot_interval or num.snapshot_interval
         self.check = window / CHECKS_PER_TRANSIT
         if self.snapshot_interval:
             self.check = min(self.check, self.snapshot_interval)
-        self.history = HistoryTracker("stick" if self.params.friction == "stick" else "slip")
-        friction_scale = P.B * self.disc.scales.theta * 1e-3
+        self.history = HistoryTracker(self.readout.history_keys)
         period = period_of(scene)
         if period is None:
             self.steady = SteadyStateTracker(num.steady_tol, window, num.settle_time,
-                                             friction_scale)
+                                             self.readout.monitor_scale)
         else:  # checks at equal phases of the period
             samples = max(CHECKS_PER_PERIOD, math.ceil(period / self.check))
             self.check = period / samples
             self.steady = PeriodicTracker(num.steady_tol, period, samples, num.settle_time,
-                                          friction_scale, P.L, self.history.model)
+                                          self.readout.monitor_scale,
+                                          self.readout.periodic_keys,
+                                          self.readout.second_scale)
         # chunks end on the drive's table rows, where its rate jumps
         self.breaks = np.array(profile_times(scene))
-        self.snapshots = (SnapshotTracker(self.snapshot_interval) if self.snapshot_interval
-                          else None)
-        self.power = PowerBalanceTracker() if hasattr(self.scheme, "work_integrals") else None
+        self.snapshots = (SnapshotTracker(self.snapshot_interval, self.readout.snapshot_keys)
+                          if self.snapshot_interval else None)
+        self.power = (PowerBalanceTracker() if hasattr(self.scheme, "work_integrals")
+                      and not self.disc.closed else None)
         self._measured = None
 
     # views ------------------------------------------------------------
@@ -131,29 +134,27 @@ class Simulation:
 
     def total_friction(self) -> float:
         """The state's total friction now (N), the sum of the nodal friction forces."""
+        return float(self.state.fnode.sum())
+
+    def monitor(self) -> float:
+        """What the steady test watches now: the total friction (N) of an open layout,
+        the driver's torque (N m) of a drive."""
         return self._measure()[0]
 
     def rate(self) -> float:
-        """Largest local rate, relative to c abs(e0) (per unit length for theta)."""
+        """Largest local rate, relative to the layout's scales (c abs(e0) on an open
+        layout, per unit length for theta; a drive's speeds and the creep speed)."""
         return self._measure()[1]
 
     def _measure(self):
         if self._measured is None:
-            P, s = self.disc.params, self.disc.scales
-            v = P.c * s.theta
-            rate = max(np.max(np.abs(self.state.ud)), P.L * np.max(np.abs(self.state.td))) / v
-            self._measured = (float(self.state.fnode.sum()), float(rate))
+            self._measured = (self.readout.monitor(self.state), self.readout.rate(self.state))
         return self._measured
 
-    def solution(self) -> DiscreteSolution:
-        """The state now, read as a solution (fields, totals, slip start)."""
-        n = self.numerics
+    def solution(self):
+        """The state now, read as a solution (fields, totals, the layout's figures)."""
         # a steady solve's state is the final drive's, whatever the clock says
-        mismatch = mismatch_at(self.disc.drive, self.t) if self.scheme.transient else None
-        return DiscreteSolution(self.params, self.grid, self.state.u, self.state.theta,
-                                self.state.fnode, n.law_code, n.friction_scale, self.state.ud,
-                                self.state.td, mismatch,
-                                (self.disc.mesh.c0, self.disc.mesh.wf, self.disc.mesh.sw))
+        return self.readout.solution(self.state, self.t, self.scheme.transient)
 
     # stepping ---------------------------------------------------------
     def warm_up(self) -> float:
@@ -173,7 +174,7 @@ class Simulation:
         user's ``extra`` trackers, the progress bar, the steady-state test, and the
         stop requests (callback, signals) and the checkpoint last.
         """
-        out: list[Tracker] = [DivergenceGuard(), self.history]
+        out: list[Tracker] = [DivergenceGuard(), OutcomeTracker(), self.history]
         if self.power is not None:
             out.append(self.power)
         if self.snapshots is not None:
@@ -405,16 +406,7 @@ def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,
     >>> result = beltsim.run(beltsim.paper_scene("slip"), progress=True)  # doctest: +SKIP
     >>> result.converged, result.errors()["total_friction"]              # doctest: +SKIP
     """
-    from ..beltdrive.scene import DriveScene
-    from .result import reference_of
-
-    if isinstance(scene, DriveScene):
-        from ..beltdrive.run import simulate
-
-        if trackers:
-            raise UsageError("trackers: not available for a closed drive yet")
-        return simulate(scene, snapshot_interval=snapshot_interval)
-    result = Simulation(scene, snapshot_interval=snapshot_interval).run(
-        progress=progress, raise_on_failure=raise_on_failure, trackers=trackers)
-    result.reference = reference_of(scene)
+    sim = Simulation(scene, snapshot_interval=snapshot_interval)
+    result = sim.run(progress=progress, raise_on_failure=raise_on_failure, trackers=trackers)
+    result.reference = sim.readout.reference()
     return result

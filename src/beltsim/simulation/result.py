@@ -12,7 +12,7 @@ from ..problem import analytic
 from ..problem.drive import period_of
 from ..problem.scene import Scene
 from ..solvers.settings import Numerics
-from .solution import DiscreteSolution, compare
+from .solution import DiscreteSolution
 
 
 class RunStatus(enum.Enum):
@@ -22,6 +22,8 @@ class RunStatus(enum.Enum):
     REACHED_END = "reached t_end"  # t_end reached before steady state
     FAILED = "failed"  # stopped on a numerical failure; the state is the last good one
     INTERRUPTED = "interrupted"  # a signal or a callback asked it to stop
+    GROSS_SLIP = "gross slip"  # a whole wrap slides and the load wins: a physical outcome
+    LIFT_OFF = "lift-off"  # the contact pressure fell to zero: outside this model
 
 
 @dataclass
@@ -150,7 +152,7 @@ class RunResult:
         """
         if self.reference is None:
             return None
-        return compare(self.solution, self.reference)
+        return self.solution.errors(self.reference)
 
     def summary(self) -> dict:
         """What ``summary.json`` holds: the final state's totals and how the run went.

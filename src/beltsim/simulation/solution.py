@@ -85,6 +85,10 @@ class DiscreteSolution:
         """The friction traction (N/m) at the nodes, as ``fields()['friction']``."""
         return traction(self.fnode, self.wf)
 
+    def errors(self, ref) -> dict:
+        """The errors against the exact steady state ``ref`` (:func:`compare`)."""
+        return compare(self, ref)
+
     def fields(self) -> dict:
         """Nodal fields with the analytic header: strain and moment averaged from elements."""
         he = self.grid.he

@@ -144,22 +144,30 @@ class DivergenceGuard(Tracker):
         return None
 
 
-class HistoryTracker(Tracker):
-    """At every check: t, total friction, the largest local rate, and the friction split.
+class OutcomeTracker(Tracker):
+    """A physical outcome that ends the run (a drive's gross slip or lift-off): reported
+    as such, with its status, not as a numerical failure."""
 
-    Coulomb scenes add the slip start, the stick and slip parts of the friction and the
-    slip power (the friction law's dissipation at that moment), perfect adhesion the
-    concentrated force, read off the state as in the summary.
+    def handle(self, sim):
+        out = sim.readout.outcome(sim)
+        return None if out is None else Stop(*out)
+
+
+class HistoryTracker(Tracker):
+    """At every check: t, the largest local rate and the layout's figures.
+
+    ``keys`` come from the layout's readout (:mod:`beltsim.simulation.readout`): on the
+    paper's belt the total friction and, for Coulomb scenes, the slip start, the stick
+    and slip parts of the friction and the slip power (the friction law's dissipation at
+    that moment), for perfect adhesion the concentrated force; on a drive its span
+    tensions, speeds, slip arcs, torque and powers. Each is read off the state as in the
+    summary.
     """
 
     name = "history"
-    BASE = ("t", "total_friction", "rate")
-    SPLIT = {"slip": ("slip_start", "stick_friction", "slip_friction", "slip_power"),
-             "stick": ("concentrated_force",)}
 
-    def __init__(self, model: str):
-        self.model = model
-        self.keys = self.BASE + self.SPLIT[model]
+    def __init__(self, keys):
+        self.keys = tuple(keys)
         self.data = {k: [] for k in self.keys}
 
     def handle(self, sim):
@@ -185,8 +193,10 @@ class HistoryTracker(Tracker):
 
 class SteadyStateTracker(Tracker):
     """Steady when, ``hold`` checks in a row after the ramp, both the largest local rate
-    (max abs(u_t) and L max abs(theta_t), relative to c abs(e0)) and the change of the total
-    friction over one window of simulated time (relative to its value) are below ``tol``.
+    (``sim.rate()``: on the paper's belt max abs(u_t) and L max abs(theta_t), relative to
+    c abs(e0)) and the change of the monitored quantity (``sim.monitor()``: the total
+    friction, or a drive's torque) over one window of simulated time (relative to its
+    value, or to ``friction_scale`` where that is larger) are below ``tol``.
     """
 
     name = "steady"
@@ -219,7 +229,7 @@ class SteadyStateTracker(Tracker):
         return self._count >= self.hold
 
     def handle(self, sim):
-        if self.update(sim.t, sim.rate(), sim.total_friction()):
+        if self.update(sim.t, sim.rate(), sim.monitor()):
             return Stop(RunStatus.CONVERGED)
         return None
 
@@ -242,22 +252,22 @@ class PeriodicTracker(Tracker):
     """A periodic steady state of a periodic drive.
 
     The checks fall at ``samples`` equal phases of each period; after ``t_min`` (the
-    ramp) the total friction and the history's second quantity (slip start, or the
-    concentrated force) of the last period are compared, phase by phase, with the
-    period before: periodic when the largest change is below ``tol`` (relative to the
-    friction, and to L for the slip start) at ``hold`` checks in a row.
+    ramp) the first two of the history's ``keys`` (the total friction and the slip start
+    or the concentrated force; a drive's torque and driven speed) of the last period are
+    compared, phase by phase, with the period before: periodic when the largest change is
+    below ``tol`` (relative to the first's magnitude, at least ``friction_scale``, and to
+    ``second_scale``, or the first's scale) at ``hold`` checks in a row.
     """
 
     name = "steady"
 
     def __init__(self, tol: float, period: float, samples: int, t_min: float,
-                 friction_scale: float, length: float, model: str, hold: int = 3):
+                 friction_scale: float, keys, second_scale: float | None, hold: int = 3):
         self.tol, self.period, self.samples, self.t_min = tol, period, samples, t_min
-        self.second = "slip_start" if model == "slip" else "concentrated_force"
         # reported over the last period; the first two are compared between periods
-        self.keys = ("total_friction", self.second) + (("slip_power",) if model == "slip"
-                                                       else ())
-        self.friction_scale, self.length, self.hold = friction_scale, length, hold
+        self.keys = tuple(keys)
+        self.friction_scale, self.second_scale, self.hold = (friction_scale, second_scale,
+                                                             hold)
         self._rows: deque = deque(maxlen=2 * samples)
         self._count = 0
         self.change = math.inf
@@ -272,7 +282,7 @@ class PeriodicTracker(Tracker):
         rows = np.array(self._rows)
         old, new = rows[: self.samples], rows[self.samples:]
         scale = max(np.abs(new[:, 1]).max(), self.friction_scale)
-        second_scale = self.length if self.second == "slip_start" else scale
+        second_scale = self.second_scale if self.second_scale is not None else scale
         self.change = max(np.abs(new[:, 1] - old[:, 1]).max() / scale,
                           np.abs(new[:, 2] - old[:, 2]).max() / second_scale)
         self._count = self._count + 1 if self.change < self.tol else 0
@@ -305,22 +315,22 @@ class PeriodicTracker(Tracker):
 
 
 class SnapshotTracker(Tracker):
-    """The state at (about) every ``interval`` of simulated time, and at the end."""
+    """The state at (about) every ``interval`` of simulated time, and at the end: the
+    arrays ``keys`` of the state (the layout's readout names them)."""
 
     name = "snapshots"
-    KEYS = ("u", "theta", "fnode")
 
-    def __init__(self, interval: float):
+    def __init__(self, interval: float, keys=("u", "theta", "fnode")):
         self.interval = interval
+        self.keys = tuple(keys)
         self.times: list = []
-        self.fields: dict = {k: [] for k in self.KEYS}
+        self.fields: dict = {k: [] for k in self.keys}
 
     def take(self, sim):
         """Store the state now."""
         self.times.append(sim.t)
-        self.fields["u"].append(sim.state.u.copy())
-        self.fields["theta"].append(sim.state.theta.copy())
-        self.fields["fnode"].append(sim.state.fnode.copy())
+        for k in self.keys:
+            self.fields[k].append(getattr(sim.state, k).copy())
 
     def initialize(self, sim):
         if not self.times:
@@ -344,7 +354,7 @@ class SnapshotTracker(Tracker):
 
     def restore(self, data):
         self.times = list(data["t"])
-        for k in self.KEYS:
+        for k in self.keys:
             self.fields[k] = list(data[k])
 
 
@@ -408,7 +418,7 @@ class ProgressTracker(Tracker):
     def handle(self, sim):
         if self.bar is not None:
             self.bar.update(min(sim.t, sim.numerics.t_end) - self.bar.n)
-            self.bar.set_postfix(rate=f"{sim.rate():.2e}", friction=f"{sim.total_friction():.5g}",
+            self.bar.set_postfix(rate=f"{sim.rate():.2e}", monitor=f"{sim.monitor():.5g}",
                                  refresh=False)
         return None
 

@@ -4,7 +4,8 @@ Importing this package registers every scheme (see :mod:`beltsim.solvers.base`).
 """
 
 from . import esdirk, explicit, implicit, pseudo, steady  # noqa: F401  (each registers its scheme)
-from .base import Discretisation, Scheme
+from .base import Discretisation, LoopDiscretisation, Scheme, discretise
 from .registry import applicable, get, names, register
 
-__all__ = ["Discretisation", "Scheme", "applicable", "get", "names", "register"]
+__all__ = ["Discretisation", "LoopDiscretisation", "Scheme", "applicable", "discretise", "get",
+           "names", "register"]

@@ -108,7 +108,7 @@ def initial_acceleration(state, base, t, mesh, p, drive, loads, w, au, at):
     nodes = u.shape[0]
     off = mesh.off
     hh, code = p.half_height, p.law
-    c = loop_speed(g, p)
+    c = loop_speed(g, mesh, p)
     target = mismatch(drive, t)
     rim = value(drive.speed, t)
     for j in mesh.cn:
@@ -279,7 +279,7 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
             for k in range(ng):
                 eg[k] = h * (d0 * vg[0, k] + d1 * vg[1, k] + d2 * vg[2, k] + d3 * vg[3, k])
             filtered_error(e, eg, a0, p.friction_scale * friction_factor(drive, t + h),
-                           loop_speed(g, p), mesh, p, w, te, teg)
+                           loop_speed(g, mesh, p), mesh, p, w, te, teg)
             for r in range(n):
                 err = max(err, abs(e[r, 0]) / scales.u, abs(e[r, 1]) / scales.theta)
             for k in range(ng):

@@ -236,7 +236,7 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
                 e[i, 0] = err_const * h * h * (au_new[j] - hist.au[j])
                 e[i, 1] = err_const * h * h * (at_new[j] - hist.at[j])
             filtered_error(e, eg, a0, p.friction_scale * friction_factor(drive, t + h),
-                           loop_speed(g, p), mesh, p, w, te, teg)
+                           loop_speed(g, mesh, p), mesh, p, w, te, teg)
             for i in range(n):
                 err = max(err, abs(e[i, 0]) / scales.u, abs(e[i, 1]) / scales.theta)
             for k in range(ng):

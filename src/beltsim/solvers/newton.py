@@ -243,7 +243,7 @@ def friction_forces(lam, fnode, u, g, t, mesh, p, drive):
     """The nodal friction forces of the friction ratios lam, as
     :func:`~beltsim.physics.model.assemble` sets them."""
     fs = p.friction_scale * friction_factor(drive, t)
-    c = loop_speed(g, p)
+    c = loop_speed(g, mesh, p)
     for j in mesh.cn:
         S, _, _ = bound_scale(mesh.seg[j], j, u, c, fs, mesh, p)
         fnode[j] = -mesh.wf[j] * S * lam[j]
@@ -330,7 +330,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
         if p.dual:
             for j in mesh.cn:
                 w.lam0[j] = lam[j]
-            dlam = update_multipliers(lam, dx, dg, inv_dt, loop_speed(g, p), mesh, p, w)
+            dlam = update_multipliers(lam, dx, dg, inv_dt, loop_speed(g, mesh, p), mesh, p, w)
             for i in range(n):
                 u[i + off] += dx[i, 0]
                 th[i + off] += dx[i, 1]
@@ -417,7 +417,7 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
     for j in range(s.active.shape[0]):
         s.active[j] = -1.0
     assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
-    saddle_system(lam, loop_speed(g, p), inv_dt, fs, mesh, p, w, s)
+    saddle_system(lam, loop_speed(g, mesh, p), inv_dt, fs, mesh, p, w, s)
     previous = np.inf
     for it in range(settings.max_iterations):
         st.newton_iterations += 1
@@ -439,7 +439,7 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
         for j in mesh.cn:
             lam[j] += s.dx[j - off, 2]
         assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
-        changed = saddle_system(lam, loop_speed(g, p), inv_dt, fs, mesh, p, w, s)
+        changed = saddle_system(lam, loop_speed(g, mesh, p), inv_dt, fs, mesh, p, w, s)
         update = max(step, dlam)
         # a front node may flip between stick and slip at round-off: a residual at its
         # floor ends the iteration whatever the pattern did
@@ -449,7 +449,7 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
         if done:
             project(lam, mesh, p.law)  # the sliding ratios, off +-1 by round-off
             friction_forces(lam, fnode, u, g, t, mesh, p, drive)
-            add_stick_penalty(w, inv_dt, fs, loop_speed(g, p), mesh, p)
+            add_stick_penalty(w, inv_dt, fs, loop_speed(g, mesh, p), mesh, p)
             return factorise(w, mesh)
     st.merit = merit(w.R, w.Rg, scales)
     return False

@@ -1,0 +1,254 @@
+"""A closed drive's discrete state read as a solution: nodal fields along the loop, the
+drive's figures (span tensions, speeds, slip arcs, torque, efficiency, powers) and the
+errors against the exact steady state.
+
+:class:`LoopSolution` is to a loop what :class:`~beltsim.simulation.solution.
+DiscreteSolution` is to the open layout: the run loop, the result, the writer and the
+plots read both through the same attributes (``x``, ``fields()``, ``summary()``,
+``errors()``, ``monitor``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..physics.friction import EXACT, saturation
+from ..physics.model import POWER_TERMS, power_terms, traction
+from ..problem.drive import value
+
+#: the drive's figures (the exact solutions give the same keys)
+SUMMARY_KEYS = ("tight_tension", "slack_tension", "belt_speed", "driven_speed", "speed_ratio",
+                "slip_arc_driver", "slip_arc_driven", "driver_torque", "efficiency",
+                "slip_power")
+#: the terms of the loop's power balance (W) and its stored energy (J)
+POWER_KEYS = ("driver_power", "load_power", "damping_power", "gyroscopic_power",
+              "transport_power", "energy")
+#: nodal fields of fields.csv, after x
+FIELD_KEYS = ("u", "theta", "tension", "friction", "pressure", "slip_velocity", "slip")
+#: what a history records at every check
+HISTORY_KEYS = ("t", "omega1", "load_torque", *SUMMARY_KEYS, *POWER_KEYS)
+
+
+class LoopSolution:
+    """A loop's state at time t read as the drive's solution.
+
+    Parameters
+    ----------
+    disc : beltsim.solvers.base.LoopDiscretisation
+        The drive on its grid.
+    state : beltsim.physics.model.State
+        The state (copied).
+    t : float or None
+        Its time, for the drive's profiles (None: a steady state, the final values).
+    """
+
+    model = "drive"
+
+    def __init__(self, disc, state, t=None):
+        self.params = disc.params
+        self.mesh = m = disc.mesh
+        self.numerics = disc.numerics
+        self.x = disc.grid.x.copy()
+        self.wf = m.wf
+        self.state = state.copy()
+        drive = disc.steady_drive() if t is None else disc.drive
+        self.rim1, self.load = value(drive.speed, t or 0.0), value(drive.load, t or 0.0)
+        # the kernel's power terms of the rows: slip, damping, gyroscopic
+        terms = np.zeros(len(POWER_TERMS))
+        power_terms(state, t or 0.0, disc.mesh, disc.model, drive, disc.loads, terms)
+        self._terms = dict(zip(POWER_TERMS, terms))
+        self.c, self.omega2 = float(state.g[0]), float(state.g[1])
+        self.cdot = float(state.gd[0])
+        self.omega2_rate = float(state.gd[1])
+        self._fields = self._read(disc.model)
+
+    def _read(self, prm) -> dict:
+        P, m, s = self.params, self.mesh, self.state
+        N = len(self.x)
+        idx = (np.arange(N)[:, None] + np.arange(-2, 1)[None, :]) % N
+        lever = prm.half_height
+        # axial force: the upwind three-point strain (the friction's) at every node
+        eps = np.sum(m.sw * s.u[idx], axis=1)
+        epsb = np.sum(m.sw * (s.u + lever * s.theta)[idx], axis=1)
+        tension = P.N0 + P.b1 * eps
+        on = m.seg >= 0
+        R = np.where(on, m.seg_radius[np.maximum(m.seg, 0)], 1.0)
+        p = np.where(on, (tension - P.rho * self.c**2) / R, 0.0)
+        f = traction(s.fnode, m.wf)
+        rim = np.where(on & (m.seg_speed[np.maximum(m.seg, 0)] >= 1),
+                       self.omega2 * P.geometry.R2, self.rim1)
+        vrel = np.where(on, self.c * (1.0 + P.N0 / P.b1 + epsb) + s.ud + lever * s.td - rim,
+                        0.0)
+        # sliding: the ratio at the bound (exact law) or saturated (a regularised law)
+        level = 1.0 - 1e-9 if prm.law == EXACT else saturation(prm.law)
+        slip = on & (np.abs(s.lam) >= level) if P.mu is not None else np.zeros(N, bool)
+        return {"u": s.u.copy(), "theta": s.theta.copy(), "u_t": s.ud.copy(),
+                "theta_t": s.td.copy(), "tension": tension, "friction": f, "pressure": p,
+                "slip_velocity": vrel, "slip": slip, "ratio": s.lam.copy(),
+                "bottom_strain": np.where(on, epsb, 0.0)}
+
+    # fields ---------------------------------------------------------
+    def fields(self) -> dict:
+        """The nodal fields of fields.csv (FIELD_KEYS), one value a node."""
+        return {k: self._fields[k] for k in FIELD_KEYS}
+
+    @property
+    def all_fields(self) -> dict:
+        """Every nodal field: FIELD_KEYS and u_t, theta_t, the friction ratio and the
+        bottom fibre's strain."""
+        return dict(self._fields)
+
+    # figures --------------------------------------------------------
+    def span_tensions(self) -> tuple[float, float]:
+        """Mean axial force over the tight and the slack span: N0 + b1 (u_end - u_start) /
+        l, exact for the nodal values (the integral of the elements' strains)."""
+        P, u = self.params, self.state.u
+        k = [int(np.argmin(np.abs(self.x - b))) for b in P.geometry.bounds[:4]]
+        ls = P.geometry.span
+        return (P.N0 + P.b1 * (u[k[0]] - u[k[3]]) / ls,
+                P.N0 + P.b1 * (u[k[2]] - u[k[1]]) / ls)
+
+    def slip_arcs(self) -> tuple[float, float]:
+        """The slip arc of each pulley (rad): the sliding nodes' contact lengths plus the
+        sliding share of the last sticking node next to them.
+
+        A node's friction is the integral of f over its volume. With the front inside the
+        volume of the last sticking node j, a share phi of it slides (ratio +-1) and the
+        rest sticks with the stick zone's ratio lam_s, so lam_j = (1 - phi) lam_s + phi
+        sign: phi = (lam_j - lam_s) / (sign - lam_s), with lam_s extrapolated linearly
+        from the two sticking nodes upstream (zero for the string, whose stick zones carry
+        no friction). The front is then located within a cell, not at its nodes.
+        """
+        m, f = self.mesh, self._fields
+        lam, slide = f["ratio"], f["slip"]
+        N = len(self.x)
+        out = []
+        for a in range(len(m.seg_radius)):
+            js = np.flatnonzero(m.seg == a)
+            length = float(np.sum(m.wf[js][slide[js]]))
+            for j in (js[slide[js]] - 1) % N:
+                if m.seg[j] != a or slide[j]:
+                    continue  # not the sticking node in front of a sliding run
+                sign = math.copysign(1.0, lam[(j + 1) % N])
+                j1, j2 = (j - 1) % N, (j - 2) % N
+                lam_s = 0.0
+                if m.seg[j1] == a and m.seg[j2] == a and not (slide[j1] or slide[j2]):
+                    lam_s = 2.0 * lam[j1] - lam[j2]
+                if sign != lam_s:
+                    phi = min(1.0, max(0.0, (lam[j] - lam_s) / (sign - lam_s)))
+                    length += m.wf[j] * phi
+            out.append(length / m.seg_radius[a])
+        return out[0], out[1]
+
+    def driver_torque(self) -> float:
+        """M1 = R1 (the friction on the driver's arc) (N m)."""
+        F = self.state.fnode
+        return self.params.geometry.R1 * float(np.sum(F[self.mesh.seg == 0]))
+
+    @property
+    def monitor(self) -> float:
+        """The quantity whose change over a transit the steady test watches: the driver's
+        torque (N m)."""
+        return self.driver_torque()
+
+    def power_terms(self) -> dict:
+        """The semi-discrete power balance of the loop (W) and its stored energy E (J)::
+
+            dE/dt = driver - load - slip - damping - gyroscopic + transport
+
+        It follows from the rows of the axial equation times (c + u_t), the bending rows
+        times theta_t and the driven pulley's times omega2, summed over the loop (the
+        gauge makes every sum of hbar u_t vanish): E = rho Lambda c^2 / 2 + the belt's
+        kinetic energy of u_t, theta_t + B(c), A(c), b2 strain energies + J2 omega2^2 /
+        2; slip = -sum F v_rel; damping = d sum hbar (rho u_t^2 + I theta_t^2);
+        gyroscopic: the gyroscopic term's work, the upwind form's numerical dissipation
+        (>= 0); transport = -c sum F (N0 / b1 + eps_b) - c c_t (rho sum (du)^2 / h + I
+        sum (dtheta)^2 / h), the linearised model's exchange through the transported
+        strain and the speed-dependent stiffnesses (zero at a steady state, to the
+        grid's error).
+        """
+        P, m, f = self.params, self.mesh, self._fields
+        c, w2 = self.c, self.omega2
+        F = self.state.fnode
+        ud, td = f["u_t"], f["theta_t"]
+        du = np.diff(np.append(f["u"], f["u"][0]))
+        dth = np.diff(np.append(f["theta"], f["theta"][0]))
+        he, hb = m.he, m.hb
+        strain_u, strain_t = float(np.sum(du * du / he)), float(np.sum(dth * dth / he))
+        B, A = P.b1 - P.rho * c * c, P.a - P.I * c * c
+        energy = (0.5 * P.rho * P.geometry.loop_length * c * c
+                  + 0.5 * float(np.sum(hb * (P.rho * ud * ud + P.I * td * td)))
+                  + 0.5 * (B * strain_u + A * strain_t
+                           + P.b2 * float(np.sum(hb * f["theta"] ** 2)))
+                  + 0.5 * P.J2 * w2 * w2)
+        return {
+            "driver_power": self.driver_torque() * self.rim1 / P.geometry.R1,
+            "load_power": self.load * w2,
+            "damping_power": float(self._terms["damping"]),
+            "gyroscopic_power": float(self._terms["gyroscopic"]),
+            "transport_power": float(-c * np.sum(F * (P.N0 / P.b1 + f["bottom_strain"])))
+            - c * self.cdot * (P.rho * strain_u + P.I * strain_t),
+            "energy": energy,
+        }
+
+    def summary(self, path: bool = False) -> dict:
+        """The drive's figures (SUMMARY_KEYS), the driver's and the load's power, the
+        power terms and, with ``path``, the driver's speed and the load of this time."""
+        P = self.params
+        T1, T2 = self.span_tensions()
+        M1 = self.driver_torque()
+        s1, s2 = self.slip_arcs()
+        omega1 = self.rim1 / P.geometry.R1
+        slip_power = float(self._terms["slip"])
+        ratio = self.omega2 * P.geometry.R2 / self.rim1 if self.rim1 > 0 else math.nan
+        eff = (self.load * self.omega2 / (M1 * omega1) if M1 * omega1 > 0 and self.load > 0
+               else math.nan)
+        out = {"tight_tension": T1, "slack_tension": T2, "belt_speed": self.c,
+               "driven_speed": self.omega2, "speed_ratio": ratio, "slip_arc_driver": s1,
+               "slip_arc_driven": s2, "driver_torque": M1, "efficiency": eff,
+               "slip_power": slip_power, **self.power_terms()}
+        if path:
+            out.update(omega1=omega1, load_torque=self.load)
+        return out
+
+    # outcomes ---------------------------------------------------------
+    def lift_off(self) -> str | None:
+        """Why the state is outside the model (a contact pressure <= 0), or None."""
+        on = self.mesh.seg >= 0
+        p = self._fields["pressure"]
+        bad = np.flatnonzero(on & (p <= 0.0))
+        if bad.size == 0:
+            return None
+        return (f"the contact pressure fell to zero at x = {self.x[bad[0]]:.4g} m (the belt "
+                f"lifts off; this model does not describe lift-off)")
+
+    def sliding_arc(self) -> str | None:
+        """The pulley whose whole wrap slides ("driver", "driven pulley"), or None."""
+        slide = self._fields["slip"]
+        for a, name in enumerate(("driver", "driven pulley")):
+            if np.all(slide[self.mesh.seg == a]):
+                return name
+        return None
+
+    # errors -----------------------------------------------------------
+    def errors(self, ref) -> dict:
+        """Relative errors of the figures against the exact steady state ``ref`` (speed
+        loss 1 - speed_ratio compared as itself; slip arcs relative to the wrap)."""
+        mine, ex = self.summary(), ref.summary()
+        out = {}
+        keys = ["tight_tension", "slack_tension", "belt_speed", "driven_speed",
+                "driver_torque"]
+        if self.params.mu is not None:
+            # with perfect adhesion every node sticks: the exits' dissipation is not a
+            # nodal slip power but the transport term's (power_terms)
+            keys.append("slip_power")
+        for key in keys:
+            out[key] = ((mine[key] - ex[key]) / abs(ex[key]) if ex[key] else abs(mine[key]))
+        loss, loss_ex = 1.0 - mine["speed_ratio"], 1.0 - ex["speed_ratio"]
+        out["speed_loss"] = (loss - loss_ex) / abs(loss_ex) if loss_ex else abs(loss)
+        wraps = self.params.geometry.wraps
+        out["slip_arc_driver"] = (mine["slip_arc_driver"] - ex["slip_arc_driver"]) / wraps[0]
+        out["slip_arc_driven"] = (mine["slip_arc_driven"] - ex["slip_arc_driven"]) / wraps[1]
+        return out

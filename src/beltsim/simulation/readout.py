@@ -1,0 +1,139 @@
+"""What a run reads off its state, layout by layout: the solution, the rate and the
+quantity the steady test watches, the history's keys, a periodic drive's comparisons,
+the snapshots' arrays, the physical outcomes and the exact steady state.
+
+The run loop (:mod:`beltsim.simulation.controller`) and its trackers read every layout
+through a :class:`Readout`; :func:`readout_of` picks the layout's.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import NoSolutionError
+from ..problem.drive import mismatch as mismatch_at
+from .loop_solution import HISTORY_KEYS, LoopSolution
+from .result import RunStatus, reference_of
+from .solution import DiscreteSolution
+
+#: checks in a row with a whole wrap sliding and the driven pulley slowing: gross slip
+GROSS_SLIP_CHECKS = 3
+
+
+class Readout:
+    """The open layout's (the paper's belt): total friction, slip start or concentrated
+    force, against the exact steady solution of the paper."""
+
+    #: what snapshots store of the state (arrays over the nodes)
+    snapshot_keys = ("u", "theta", "fnode")
+
+    def __init__(self, disc):
+        self.disc = disc
+        P = disc.params
+        self.model = "stick" if P.friction == "stick" else "slip"
+        split = {"slip": ("slip_start", "stick_friction", "slip_friction", "slip_power"),
+                 "stick": ("concentrated_force",)}
+        self.history_keys = ("t", "total_friction", "rate", *split[self.model])
+        #: the monitor's scale: its changes are measured against at least this
+        self.monitor_scale = P.B * disc.scales.theta * 1e-3
+        second = "slip_start" if self.model == "slip" else "concentrated_force"
+        #: a periodic drive's quantities: the first two compared between periods, the
+        #: second relative to ``second_scale`` (None: the first's scale)
+        self.periodic_keys = ("total_friction", second) + (
+            ("slip_power",) if self.model == "slip" else ())
+        self.second_scale = P.L if self.model == "slip" else None
+
+    def solution(self, state, t: float, transient: bool):
+        """The state read as a solution (a steady solve's: the final drive's)."""
+        d, n = self.disc, self.disc.numerics
+        mismatch = mismatch_at(d.drive, t) if transient else None
+        return DiscreteSolution(d.params, d.grid, state.u, state.theta, state.fnode,
+                                n.law_code, n.friction_scale, state.ud, state.td, mismatch,
+                                (d.mesh.c0, d.mesh.wf, d.mesh.sw))
+
+    def monitor(self, state) -> float:
+        """The total friction (N): what the steady test watches."""
+        return float(state.fnode.sum())
+
+    def rate(self, state) -> float:
+        """Largest local rate, relative to c abs(e0) (per unit length for theta)."""
+        P, s = self.disc.params, self.disc.scales
+        v = P.c * s.theta
+        return float(max(np.max(np.abs(state.ud)), P.L * np.max(np.abs(state.td))) / v)
+
+    def outcome(self, sim):
+        """A physical outcome that ends the run, as (status, reason), or None."""
+        return None
+
+    def reference(self):
+        """The exact steady solution of the scene, or None."""
+        return reference_of(self.disc.scene)
+
+
+class LoopReadout(Readout):
+    """A closed drive's: the driver's torque, the span tensions, the speeds and slip arcs,
+    against the creep theory (string) or the beam's exact steady state; lift-off and
+    gross slip end a run as outcomes."""
+
+    snapshot_keys = ("u", "theta", "fnode", "lam", "g")
+
+    def __init__(self, disc):
+        self.disc = disc
+        P = disc.params
+        self.model = "drive"
+        self.history_keys = HISTORY_KEYS[:1] + ("rate",) + HISTORY_KEYS[1:]
+        self.monitor_scale = 1e-3 * P.N0 * P.geometry.R1
+        self.periodic_keys = ("driver_torque", "driven_speed", "tight_tension",
+                              "slack_tension", "belt_speed")
+        self.second_scale = P.omega1 * P.geometry.R1 / P.geometry.R2
+        self._sliding = 0
+
+    def solution(self, state, t: float, transient: bool):
+        return LoopSolution(self.disc, state, t if transient else None)
+
+    def monitor(self, state) -> float:
+        """The driver's torque (N m)."""
+        m = self.disc.mesh
+        return self.disc.params.geometry.R1 * float(np.sum(state.fnode[m.seg == 0]))
+
+    def rate(self, state) -> float:
+        """The largest rate of the belt's and the driven pulley's speeds and of u, each
+        over its scale (the rim speed, the creep speed) times the transit time."""
+        P = self.disc.params
+        rim = P.omega1 * P.geometry.R1
+        creep = rim * P.N0 / P.b1
+        return float(max(abs(state.gd[0]) / rim, abs(state.gd[1]) * P.geometry.R2 / rim,
+                         np.max(np.abs(state.ud)) / creep) * self.disc.window)
+
+    def outcome(self, sim):
+        """Lift-off, or gross slip: a whole wrap slides while the driven pulley slows,
+        GROSS_SLIP_CHECKS checks in a row."""
+        sol = sim.solution()
+        why = sol.lift_off()
+        if why is not None:
+            return RunStatus.LIFT_OFF, f"t = {sim.t:.6g} s: {why}"
+        which = sol.sliding_arc()
+        self._sliding = self._sliding + 1 if which and sim.state.gd[1] < 0 else 0
+        if self._sliding >= GROSS_SLIP_CHECKS:
+            return RunStatus.GROSS_SLIP, (
+                f"t = {sim.t:.6g} s: the belt slides over the {which}'s whole wrap and the "
+                f"driven pulley slows down ({sim.state.g[1]:.6g} rad/s)")
+        return None
+
+    def reference(self):
+        from ..beltdrive.analytic import solve_string
+        from ..beltdrive.beam import solve_beam
+
+        scene = self.disc.scene
+        if any(isinstance(scene.drive[k], dict) for k in ("driver_speed", "load_torque")):
+            return None  # a periodic drive never settles
+        P = scene.params
+        try:
+            return solve_beam(P) if P.model == "beam" else solve_string(P)
+        except NoSolutionError:
+            return None
+
+
+def readout_of(disc) -> Readout:
+    """The readout of a discretisation's layout."""
+    return LoopReadout(disc) if disc.closed else Readout(disc)
