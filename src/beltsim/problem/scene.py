@@ -882,15 +882,20 @@ def scene_names() -> tuple[str, ...]:
     """The names of the scenes shipped with beltsim (``beltsim run NAME`` runs one); none
     where the package was installed without them."""
     folder = _scenes_dir()
-    if not folder.is_dir():
+    if folder is None or not folder.is_dir():
         return ()
     return tuple(sorted(f.name[:-5] for f in folder.iterdir() if f.name.endswith(".toml")))
 
 
 def _scenes_dir():
+    """The shipped scene files: runs/, which the build installs as beltsim.scenes; None
+    where the package was installed without them."""
     from importlib.resources import files
 
-    return files("beltsim") / "scenes"
+    try:
+        return files("beltsim.scenes")
+    except ModuleNotFoundError:
+        return None
 
 
 def shipped_scene(name: str, overrides=()) -> Scene:
@@ -899,8 +904,9 @@ def shipped_scene(name: str, overrides=()) -> Scene:
     Raises :class:`~beltsim.errors.MissingInputError` when the package holds no such
     scene (an installation without its scene files included).
     """
-    resource = _scenes_dir() / f"{name}.toml"
-    if not resource.is_file():
+    folder = _scenes_dir()
+    resource = None if folder is None else folder / f"{name}.toml"
+    if resource is None or not resource.is_file():
         known = ", ".join(scene_names()) or "none installed"
         raise MissingInputError(f"{name}: no scene of that name ships with beltsim "
                                 f"(shipped: {known})")
