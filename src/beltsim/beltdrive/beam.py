@@ -71,7 +71,7 @@ import numpy as np
 from ..errors import NoSolutionError
 from . import analytic
 from .analytic import GrossSlipError, LiftOffError, solve_string
-from .scene import DriveParams
+from .params import DriveParams
 
 #: Newton stops when its scaled step falls below this ...
 STEP_TOL = 1e-13

@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from .. import solvers
-from ..errors import NumericalError, UsageError
+from ..errors import NumericalError
 from ..physics.grid import Grid
 from ..problem.drive import mismatch as mismatch_at
 from ..problem.drive import period_of, profile_times
@@ -388,10 +388,9 @@ def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,
     Returns
     -------
     RunResult
-        With ``reference``, the exact steady solution, where the scene has one. A closed
-        drive (:class:`~beltsim.beltdrive.scene.DriveScene`) runs by
-        :func:`beltsim.beltdrive.simulate` and returns its
-        :class:`~beltsim.beltdrive.run.DriveResult`.
+        With ``reference``, the exact steady solution, where the scene has one.
+        :func:`beltsim.run` takes a closed drive as well, a shipped scene's name or a
+        file's path.
 
     Raises
     ------
@@ -405,15 +404,8 @@ def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,
     >>> result = beltsim.run(beltsim.paper_scene("slip"), progress=True)  # doctest: +SKIP
     >>> result.converged, result.errors()["total_friction"]              # doctest: +SKIP
     """
-    from ..beltdrive.scene import DriveScene
     from .result import reference_of
 
-    if isinstance(scene, DriveScene):
-        from ..beltdrive.run import simulate
-
-        if trackers:
-            raise UsageError("trackers: not available for a closed drive yet")
-        return simulate(scene, snapshot_interval=snapshot_interval)
     result = Simulation(scene, snapshot_interval=snapshot_interval).run(
         progress=progress, raise_on_failure=raise_on_failure, trackers=trackers)
     result.reference = reference_of(scene)
