@@ -15,9 +15,10 @@ from __future__ import annotations
 
 import sys
 
+from beltsim.api import load_scene
 from beltsim.cli import OneLineParser
 from beltsim.errors import BeltsimError
-from beltsim.problem.scene import Scene, load_scene
+from beltsim.problem.scene import Scene
 from beltsim.simulation.controller import Simulation
 from beltsim.simulation.result import reference_of
 from beltsim.simulation.solution import relative_error

@@ -435,8 +435,8 @@ def main(argv=None) -> int:
     unknown = [p for p in peers if p not in PEERS]
     if unknown:
         parser.error(f"--peers: unknown {', '.join(unknown)}; one of {', '.join(PEERS)}")
+    from beltsim.api import load_scene
     from beltsim.beltdrive import DriveScene
-    from beltsim.problem.scene import load_scene
 
     overrides = list(args.overrides)
     if args.elements is not None:

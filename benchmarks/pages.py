@@ -126,7 +126,7 @@ def _peers_table(page: Page, lab: dict) -> None:
 
 
 def _grid_section(page: Page, ladder, repeat: int) -> list[dict]:
-    from beltsim.problem.scene import shipped_scene
+    from beltsim.api import shipped_scene
     from beltsim.studies.bench import run_ours
 
     rows = []
@@ -169,7 +169,7 @@ def _figure(page: Page, rows) -> None:
 
 
 def build(page: Page, quick: bool, cold: bool = True) -> None:
-    from beltsim.problem.scene import shipped_scene
+    from beltsim.api import shipped_scene
     from beltsim.studies import bench as ours_bench
 
     from . import bench as lab_bench
@@ -229,7 +229,7 @@ def build(page: Page, quick: bool, cold: bool = True) -> None:
 
 
 def _steady_section(page: Page, quick: bool, repeat: int) -> None:
-    from beltsim.problem.scene import shipped_scene
+    from beltsim.api import shipped_scene
     from beltsim.simulation.controller import run
     from beltsim.simulation.result import reference_of
     from beltsim.simulation.solution import relative_error

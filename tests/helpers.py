@@ -10,7 +10,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def scene_path(name: str) -> str:
     """The file of a shipped scene, e.g. scene_path("paper_slip")."""
-    return str(files("beltsim") / "scenes" / f"{name}.toml")
+    return str(files("beltsim.scenes") / f"{name}.toml")
 
 
 def cli(*args, timeout=600, **kw):

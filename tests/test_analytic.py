@@ -15,9 +15,10 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
 
+from beltsim.api import paper_scene
 from beltsim.errors import NoSolutionError
 from beltsim.problem import analytic
-from beltsim.problem.scene import Scene, paper_scene
+from beltsim.problem.scene import Scene
 
 pytestmark = pytest.mark.unit
 

@@ -51,8 +51,8 @@ def test_missing_snapshots_is_a_clean_error(tmp_path):
 
 
 def test_every_frame_names_the_scheme_and_the_damping():
+    from beltsim.api import load_scene
     from beltsim.plots.animate import scheme_label
-    from beltsim.problem.scene import load_scene
     default = scheme_label(load_scene(scene_path("paper_slip")))
     assert default == "esdirk3 (time-accurate), damping 39 1/s"
     pseudo = scheme_label(load_scene(scene_path("paper_slip"), ["numerics.integrator=pseudo"]))

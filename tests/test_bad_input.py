@@ -10,7 +10,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import beltsim
-from beltsim.problem.scene import paper_scene
+from beltsim.api import paper_scene
 from beltsim.simulation.result import RunStatus
 from beltsim.studies.stability import steady_state_stability
 from helpers import scene_path

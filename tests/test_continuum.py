@@ -5,9 +5,9 @@ import math
 
 import pytest
 
+from beltsim.api import shipped_scene
 from beltsim.physics import continuum, modes
 from beltsim.physics.continuum import Characteristic, Zone
-from beltsim.problem.scene import shipped_scene
 
 
 def _params(name="paper_slip"):

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from beltsim.api import shipped_scene
 from beltsim.physics import modes
 from beltsim.physics.friction import is_exact
 from beltsim.physics.model import (
@@ -16,7 +17,6 @@ from beltsim.physics.model import (
     model_params,
 )
 from beltsim.problem.drive import Drive
-from beltsim.problem.scene import shipped_scene
 from beltsim.simulation import trackers
 from beltsim.solvers.newton import Workspace
 from beltsim.studies import stability

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-import beltsim.problem.scene as scene_module
+import beltsim.problem.shipped as shipped_module
 import validation.pages as vpages
 from benchmarks import pages as bpages
 from validation.pages.kit import FAILED, Page, md_table, num
@@ -81,7 +81,7 @@ def no_scenes(tmp_path, monkeypatch):
     """An installation without its scene files."""
     empty = tmp_path / "no_scenes"
     empty.mkdir()
-    monkeypatch.setattr(scene_module, "_scenes_dir", lambda: empty)
+    monkeypatch.setattr(shipped_module, "scenes_dir", lambda: empty)
 
 
 def test_missing_scenes_fail_the_verification_pages(tmp_path, no_scenes):

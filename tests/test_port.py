@@ -8,8 +8,8 @@ same equations with array operations and a general sparse LU.
 import numpy as np
 import pytest
 
+from beltsim.api import load_scene
 from beltsim.physics.model import Loads
-from beltsim.problem.scene import load_scene
 from beltsim.simulation.controller import Simulation
 from benchmarks import port
 from helpers import scene_path

@@ -11,9 +11,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from beltsim import solvers
+from beltsim.api import shipped_scene
 from beltsim.errors import FailureKind
 from beltsim.problem import analytic
-from beltsim.problem.scene import Scene, shipped_scene
+from beltsim.problem.scene import Scene
 from beltsim.simulation import trackers
 from beltsim.solvers.settings import resolve
 from beltsim.studies import stability
@@ -155,7 +156,7 @@ def test_bad_random_options_are_one_line_errors(tmp_path):
 
 
 def test_the_slip_start_bound_scales_with_the_grid():
-    from beltsim.problem.scene import paper_scene
+    from beltsim.api import paper_scene
     from beltsim.studies.stability import BOUNDS
     assert rs.scene_bounds(paper_scene("slip"), 1000) == BOUNDS  # what BOUNDS were set on
     long = paper_scene("slip", ["beam.length=40", "contact.start=10", "contact.end=30"])

@@ -7,8 +7,9 @@ import tomllib
 
 import pytest
 
+from beltsim.api import load_scene
 from beltsim.errors import SceneError
-from beltsim.problem.scene import SCHEMA, Scene, load_scene
+from beltsim.problem.scene import SCHEMA, Scene
 from beltsim.solvers.settings import resolve
 from helpers import scene_path
 
@@ -210,8 +211,8 @@ def test_a_study_whose_scenes_are_missing_fails(tmp_path, monkeypatch, capsys):
     """With the scene files hidden, the stability matrix stops with a one-line error and
     a non-zero exit instead of counting every cell as refused."""
     from beltsim.cli import main
-    from beltsim.problem import scene as scene_module
-    monkeypatch.setattr(scene_module, "_scenes_dir", lambda: tmp_path / "none")
+    from beltsim.problem import shipped
+    monkeypatch.setattr(shipped, "scenes_dir", lambda: None)
     assert main(["stability", "--elements", "60", "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "no scene of that name" in err

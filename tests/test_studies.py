@@ -5,8 +5,8 @@ import json
 import numpy as np
 import pytest
 
+from beltsim.api import load_scene
 from beltsim.physics.friction import LINEAR
-from beltsim.problem.scene import load_scene
 from beltsim.simulation.controller import Simulation
 from beltsim.studies import convergence
 from benchmarks import peers

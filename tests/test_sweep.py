@@ -8,8 +8,8 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 
+from beltsim.api import paper_scene
 from beltsim.errors import SceneError, UsageError
-from beltsim.problem.scene import paper_scene
 from beltsim.studies import sweep
 from helpers import scene_path
 

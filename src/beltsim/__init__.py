@@ -10,6 +10,7 @@ A few lines do what the CLI does::
     beltsim.save_run(result, "runs/out/slip")
 """
 
+from .api import load_scene, paper_scene, run, scene_names, shipped_scene, solve
 from .errors import (
     BeltsimError,
     MissingInputError,
@@ -19,7 +20,7 @@ from .errors import (
 )
 from .io.results import save_run
 from .plots.run import plot_fields, plot_history
-from .problem.analytic import AnalyticSolution, solve
+from .problem.analytic import AnalyticSolution
 from .problem.builder import (
     Beam,
     Contact,
@@ -29,8 +30,8 @@ from .problem.builder import (
     Sine,
     Stiffness,
 )
-from .problem.scene import Scene, load_scene, paper_scene, scene_names, shipped_scene
-from .simulation.controller import Simulation, run
+from .problem.scene import Scene
+from .simulation.controller import Simulation
 from .simulation.result import RunResult, RunStatus
 from .simulation.trackers import Stop, Tracker
 

@@ -27,13 +27,13 @@ def _add_scene_args(p, **scene_kw):
 
 
 def _scene(args):
-    from .problem.scene import load_scene
+    from .api import load_scene
     return load_scene(args.scene, args.overrides)
 
 
 def _is_drive(scene) -> bool:
-    from .beltdrive.scene import DriveScene
-    return isinstance(scene, DriveScene)
+    from .api import is_drive_scene
+    return is_drive_scene(scene)
 
 
 def _straight_only(args, scene):
@@ -45,15 +45,15 @@ def _straight_only(args, scene):
 
 
 def _drive_analytic(args, scene):
-    from .beltdrive.analytic import solve_string
+    from .api import solve
     from .beltdrive.io import format_drive
-    from .beltdrive.run import analytic_of
     from .io.files import prepare_outdir, write_json
 
     out = prepare_outdir(args.out)
-    summaries = {"string": solve_string(scene.params).summary()}
+    # the creep theory, and the beam's own exact state where the scene is a beam
+    summaries = {"string": solve(scene, "string").summary()}
     if scene.params.model == "beam":
-        summaries["beam"] = analytic_of(scene.params).summary()
+        summaries["beam"] = solve(scene).summary()
     write_json(out / "summary.json", summaries)
     for name, summary in summaries.items():
         print(format_drive(summary, title=f"{scene.title or args.scene} ({name})"))
@@ -255,7 +255,7 @@ def cmd_convergence(args):
 def cmd_bench(args):
     if args.repeat < 1:
         raise UsageError(f"--repeat: must be at least 1, got {args.repeat}")
-    from .problem.scene import load_scene
+    from .api import load_scene
     from .studies import bench as studies
 
     grid = [("numerics.elements", args.elements)] if args.elements is not None else []

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from beltsim.problem.scene import shipped_scene
+from beltsim.api import shipped_scene
 from beltsim.simulation.controller import run
 
 from .kit import Page, fmt, num

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from beltsim.api import shipped_scene
 from beltsim.plots.common import save_figure
 from beltsim.plots.studies import SCHEME_STYLE, error_vs_runtime
-from beltsim.problem.scene import shipped_scene
 from beltsim.studies.convergence import (
     ERROR_KEYS,
     LADDER,

@@ -7,6 +7,7 @@ import time
 
 import numpy as np
 
+from beltsim.api import shipped_scene
 from beltsim.beltdrive import (
     DriveScene,
     DriveStatus,
@@ -17,7 +18,6 @@ from beltsim.beltdrive import (
     solve_string,
 )
 from beltsim.beltdrive.discrete import DEFAULT_ELEMENTS, loop_mesh
-from beltsim.problem.scene import shipped_scene
 
 from .kit import Page, fmt, num
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from beltsim import solvers
-from beltsim.problem.scene import shipped_scene
+from beltsim.api import shipped_scene
 from beltsim.simulation.controller import Simulation
 from beltsim.simulation.result import reference_of
 from beltsim.studies.convergence import ERROR_KEYS, RICHARDSON, richardson

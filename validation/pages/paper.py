@@ -7,10 +7,10 @@ import shutil
 import tempfile
 from pathlib import Path
 
+from beltsim.api import paper_scene
 from beltsim.plots.common import save_figure
 from beltsim.plots.paper import figures
 from beltsim.plots.studies import creep_collapse
-from beltsim.problem.scene import paper_scene
 from beltsim.studies import paper
 from beltsim.studies.sweep import run_point
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from beltsim.problem.scene import shipped_scene
+from beltsim.api import shipped_scene
 from beltsim.problem.transient import thin_belt
 from beltsim.simulation.controller import Simulation, run
 from beltsim.solvers.settings import DEFAULT_INTEGRATOR, DEFAULT_TIME_TOL

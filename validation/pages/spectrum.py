@@ -8,8 +8,8 @@ import time
 
 import numpy as np
 
+from beltsim.api import shipped_scene
 from beltsim.physics import modes
-from beltsim.problem.scene import shipped_scene
 from beltsim.simulation.controller import run
 from beltsim.solvers.settings import DEFAULT_ADHESION_LAYER, resolve
 

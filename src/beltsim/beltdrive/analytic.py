@@ -33,7 +33,7 @@ from scipy.optimize import brentq
 
 from ..errors import NoSolutionError
 from .geometry import SEGMENTS
-from .scene import DriveParams
+from .params import DriveParams
 
 
 class GrossSlipError(NoSolutionError):

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import NoSolutionError, NumericalError, SceneError
 from ..physics.friction import EXACT, saturation
-from ..problem.drive import Profile, profile_of, value
+from ..problem.drive import Profile, as_profile, value
 from .analytic import solve_string
 from .discrete import (
     DEFAULT_ELEMENTS,
@@ -118,8 +118,8 @@ def profiles(scene: DriveScene, ramp_time: float) -> tuple[Profile, Profile]:
     and sines ramp from 0 over ramp_time, tables are taken as they are."""
     d = scene.drive
     R1 = scene.params.geometry.R1
-    return (profile_of(d["driver_speed"], 0.0, 1.0 / R1, ramp_time),
-            profile_of(d["load_torque"], 0.0, 1.0, ramp_time))
+    return (as_profile(d["driver_speed"], 0.0, 1.0 / R1, ramp_time),
+            as_profile(d["load_torque"], 0.0, 1.0, ramp_time))
 
 
 def fields_of(y, lay: Layout, mesh: LoopMesh, P: DriveParams, prm, rim1: float,

@@ -21,25 +21,27 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import dataclass
 
 from ..errors import NoSolutionError, SceneError
-from ..problem.scene import (
-    _RETIRED,
+from ..problem.rules import (
+    BELT_RULES,
     POS,
     PROFILE,
-    _number,
-    _Rule,
-    _show,
-    _toml_value,
+    RETIRED,
+    STIFFNESS_RULES,
+    Rule,
     check_table,
-    final_value,
-    parse_assignment,
-    parse_toml,
-    read_scene_file,
+    number,
+    profile_extremes,
+    show,
 )
-from ..problem.scene import SCHEMA as STRAIGHT_SCHEMA
+from ..problem.tomlio import assignments, parse_toml, read_scene_file, toml_value
+from .analytic import LiftOffError, solve_string
 from .geometry import Geometry, GeometryError
+from .params import DriveParams, params_of
+
+__all__ = ["MIN_SEGMENT_ELEMENTS", "OPTIONAL_SECTIONS", "REQUIRED", "SCHEMA", "DriveParams",
+           "DriveScene", "is_drive", "max_rim_speed", "set_key", "validate"]
 
 #: The fewest elements on each of the loop's four segments.
 MIN_SEGMENT_ELEMENTS = 4
@@ -49,13 +51,13 @@ def _check_load(key, value):
     """A load torque (N m): a number >= 0 (ramped from 0) or a table of [time, value] rows."""
     if isinstance(value, list):
         return check_table(key, value, zero_allowed=True)
-    value = _number(key, value)
+    value = number(key, value)
     if not value >= 0:
         raise SceneError(key, f"must be >= 0, got {value!r}")
     return value
 
 
-class _LoadRule(_Rule):
+class _LoadRule(Rule):
     def __init__(self):
         super().__init__("load")
 
@@ -64,10 +66,10 @@ class _LoadRule(_Rule):
 
 
 #: Sections of a drive scene, their keys and rules.
-SCHEMA: dict[str, dict[str, _Rule]] = {
+SCHEMA: dict[str, dict[str, Rule]] = {
     # the straight belt's [beam] keys but its length (the loop's follows from the drive)
-    "belt": {k: rule for k, rule in STRAIGHT_SCHEMA["beam"].items() if k != "length"},
-    "stiffness": dict(STRAIGHT_SCHEMA["stiffness"]),
+    "belt": {k: rule for k, rule in BELT_RULES.items() if k != "length"},
+    "stiffness": dict(STIFFNESS_RULES),
     "drive": {
         "driver_radius": POS,
         "driven_radius": POS,
@@ -78,26 +80,26 @@ SCHEMA: dict[str, dict[str, _Rule]] = {
         "driven_inertia": POS,
     },
     "contact": {
-        "friction": _Rule("str", choices=("stick", "coulomb")),
+        "friction": Rule("str", choices=("stick", "coulomb")),
         "friction_coefficient": POS,
     },
     "physics": {
-        "inertia": _Rule("bool"),
-        "damping": _Rule("float", nonneg=True),
-        "model": _Rule("str", choices=("beam", "string")),
+        "inertia": Rule("bool"),
+        "damping": Rule("float", nonneg=True),
+        "model": Rule("str", choices=("beam", "string")),
     },
     "numerics": {
-        "integrator": _Rule("str", choices=("implicit", "explicit", "steady")),
-        "elements": _Rule("int", minimum=4 * MIN_SEGMENT_ELEMENTS),
+        "integrator": Rule("str", choices=("implicit", "explicit", "steady")),
+        "elements": Rule("int", minimum=4 * MIN_SEGMENT_ELEMENTS),
         "dt": POS,
         "t_end": POS,
-        "ramp_time": _Rule("float", nonneg=True),
-        "friction_law": _Rule("str", choices=("exact", "tanh", "sqrt")),
+        "ramp_time": Rule("float", nonneg=True),
+        "friction_law": Rule("str", choices=("exact", "tanh", "sqrt")),
         "regularisation": POS,
         "time_tol": POS,
         "steady_tol": POS,
         "newton_tol": POS,
-        "newton_max_iterations": _Rule("int", minimum=1),
+        "newton_max_iterations": Rule("int", minimum=1),
         "snapshot_interval": POS,
     },
 }
@@ -129,11 +131,11 @@ def validate(data: dict) -> dict:
     for key, value in data.items():
         if key == "title":
             if not isinstance(value, str):
-                raise SceneError("title", f"must be a string, got {_show(value)}")
+                raise SceneError("title", f"must be a string, got {show(value)}")
             out["title"] = value
         elif key in SCHEMA:
             if not isinstance(value, dict):
-                raise SceneError(f"[{key}]", f"must be a table (section), got {_show(value)}")
+                raise SceneError(f"[{key}]", f"must be a table (section), got {show(value)}")
         elif key in ("beam", "motion"):
             raise SceneError(f"[{key}]", "not in a closed drive (a scene with [drive] "
                              "describes its belt in [belt] and its motion in [drive])")
@@ -148,8 +150,8 @@ def validate(data: dict) -> dict:
         clean = {}
         for key, value in data[section].items():
             name = f"{section}.{key}"
-            if (section, key) in _RETIRED:
-                raise SceneError(name, _RETIRED[section, key])
+            if (section, key) in RETIRED:
+                raise SceneError(name, RETIRED[section, key])
             if key not in rules:
                 raise SceneError(name, f"unknown key (known in [{section}]: "
                                  f"{', '.join(rules)})")
@@ -187,7 +189,7 @@ def validate(data: dict) -> dict:
         Geometry(drive["driver_radius"], drive["driven_radius"], drive["centre_distance"])
     except GeometryError as exc:
         raise SceneError(str(exc)) from None
-    P = _params(out)
+    P = params_of(out)
     if P.rho > 0 and max_rim_speed(out) ** 2 * P.rho >= P.b1:
         raise SceneError("drive.driver_speed", f"the rim speed reaches the belt's critical "
                          f"speed sqrt(b1 / rho) = {math.sqrt(P.b1 / P.rho):.4g} m/s")
@@ -196,8 +198,6 @@ def validate(data: dict) -> dict:
                          f"critical speed sqrt(a / I) = {math.sqrt(P.a / P.I):.4g} m/s "
                          f'(a - I c^2 <= 0: no steady state; physics.model = "string" has '
                          f"none)")
-    from .analytic import LiftOffError, solve_string
-
     try:
         solve_string(P)
     except LiftOffError as exc:
@@ -207,62 +207,26 @@ def validate(data: dict) -> dict:
     return out
 
 
+def set_key(data: dict, key: str, value) -> None:
+    """Set ``SECTION.KEY`` (or ``title``) in a drive scene's tables; the section must be
+    one a drive has (:func:`validate` checks the key and its value)."""
+    if key == "title":
+        data["title"] = value
+        return
+    if "." not in key:
+        raise SceneError(key, f"expected SECTION.KEY (sections: {', '.join(SCHEMA)})")
+    section, name = key.split(".", 1)
+    if section not in SCHEMA:
+        raise SceneError(key, f"unknown section [{section}] of a drive scene "
+                         f"(sections: {', '.join(SCHEMA)})")
+    if (section, name) in RETIRED:
+        raise SceneError(key, RETIRED[section, name])
+    data.setdefault(section, {})[name] = value
+
+
 def max_rim_speed(data: dict) -> float:
     """The largest rim speed omega1 R1 (m/s) of the driver's speed profile."""
-    from ..problem.scene import profile_extremes
-
     return profile_extremes(data["drive"]["driver_speed"])[1] * data["drive"]["driver_radius"]
-
-
-@dataclass(frozen=True)
-class DriveParams:
-    """The physical data of a closed drive, in SI units (the final values of profiles).
-
-    ``rho`` and ``I`` are zero for a quasistatic scene; ``mu`` is None for perfect
-    adhesion ("stick"); ``lever`` is h / 2 for the beam and 0 for the string.
-    """
-
-    h: float
-    a: float
-    b1: float
-    b2: float
-    rho: float
-    I: float
-    inertia: bool
-    damping: float
-    model: str
-    friction: str
-    mu: float | None
-    N0: float
-    J2: float
-    omega1: float
-    M2: float
-    geometry: Geometry
-
-    @property
-    def lever(self) -> float:
-        """The friction's lever about the middle line: h / 2 (beam) or 0 (string)."""
-        return 0.5 * self.h if self.model == "beam" else 0.0
-
-
-def _params(d: dict) -> DriveParams:
-    from ..problem.scene import _stiffness
-
-    beam = dict(d["belt"])
-    stiff = _stiffness({"beam": beam, "stiffness": d.get("stiffness", {}),
-                        "physics": d["physics"]})
-    drive, contact, physics = d["drive"], d["contact"], d["physics"]
-    load = drive["load_torque"]
-    return DriveParams(
-        h=beam["height"], a=stiff["a"], b1=stiff["b1"], b2=stiff["b2"], rho=stiff["rho"],
-        I=stiff["I"], inertia=physics["inertia"],
-        damping=physics.get("damping", 0.0) if physics["inertia"] else 0.0,
-        model=physics.get("model", "beam"), friction=contact["friction"],
-        mu=contact.get("friction_coefficient"), N0=drive["installation_tension"],
-        J2=drive["driven_inertia"], omega1=final_value(drive["driver_speed"]),
-        M2=float(load[-1][1] if isinstance(load, list) else load),
-        geometry=Geometry(drive["driver_radius"], drive["driven_radius"],
-                          drive["centre_distance"]))
 
 
 class DriveScene:
@@ -280,7 +244,7 @@ class DriveScene:
     def __init__(self, data: dict, source: str | None = None):
         self._data = validate(data)
         self.source = source
-        self.params = _params(self._data)
+        self.params = params_of(self._data)
 
     @classmethod
     def load(cls, path) -> DriveScene:
@@ -305,25 +269,80 @@ class DriveScene:
         """The scene as TOML text, which :meth:`loads` reads back to an equal scene."""
         lines = []
         if "title" in self._data:
-            lines.append(f"title = {_toml_value(self._data['title'])}")
+            lines.append(f"title = {toml_value(self._data['title'])}")
         for section in SCHEMA:
             if section in self._data and self._data[section]:
                 lines.append(f"\n[{section}]")
-                lines += [f"{k} = {_toml_value(v)}" for k, v in self._data[section].items()]
+                lines += [f"{k} = {toml_value(v)}" for k, v in self._data[section].items()]
         return "\n".join(lines) + "\n"
 
     def with_overrides(self, overrides) -> DriveScene:
-        """A copy with ``SECTION.KEY=VALUE`` strings or (key, value) pairs applied."""
+        """This scene with some keys set, validated again.
+
+        Parameters
+        ----------
+        overrides : dict, str or iterable of str or (str, value)
+            ``{"drive.load_torque": 40.0}``, one ``"drive.load_torque=40"`` string (as
+            ``--set`` takes it), or an iterable of such strings or (key, value) pairs.
+
+        Returns
+        -------
+        DriveScene
+            A new scene; this one is unchanged.
+
+        Raises
+        ------
+        SceneError
+            An unknown section or key, an unparsable value, or a broken rule.
+        """
         data = self.to_dict()
-        for item in overrides:
-            key, value = parse_assignment(item) if isinstance(item, str) else item
-            if "." not in key:
-                raise SceneError(key, "expected SECTION.KEY")
-            section, name = key.split(".", 1)
-            if section not in SCHEMA:
-                raise SceneError(key, f"unknown section [{section}] of a drive scene "
-                                 f"(sections: {', '.join(SCHEMA)})")
-            data.setdefault(section, {})[name] = value
+        for key, value in assignments(overrides):
+            set_key(data, key, value)
+        return DriveScene(data, source=self.source)
+
+    def replace(self, **changes) -> DriveScene:
+        """This scene with some sections (or the title) replaced, validated again.
+
+        A section given as None is removed (the optional ``stiffness`` and ``numerics``,
+        and ``title``).
+
+        Parameters
+        ----------
+        **changes : dict, str or None
+            ``belt=``, ``stiffness=``, ``drive=``, ``contact=``, ``physics=``,
+            ``numerics=`` (the section's table as a dict) and ``title=``.
+
+        Returns
+        -------
+        DriveScene
+            A new scene; this one is unchanged.
+
+        Raises
+        ------
+        SceneError
+            An unknown section, a section that is not a table, or a broken rule.
+
+        Examples
+        --------
+        >>> heavier = scene.replace(drive=scene.drive | {"load_torque": 40.0})  # doctest: +SKIP
+        """
+        data = self.to_dict()
+        for name, value in changes.items():
+            if name == "title":
+                if value is None:
+                    data.pop("title", None)
+                else:
+                    data["title"] = value
+                continue
+            if name not in SCHEMA:
+                known = ", ".join([*SCHEMA, "title"])
+                raise SceneError(f"{name}: unknown section of a drive scene (known: {known})")
+            if value is None or (value == {} and name in OPTIONAL_SECTIONS):
+                data.pop(name, None)
+            elif isinstance(value, dict):
+                data[name] = copy.deepcopy(value)
+            else:
+                raise SceneError(f"[{name}]", f"must be a table (a dict), got {show(value)}")
         return DriveScene(data, source=self.source)
 
     @property

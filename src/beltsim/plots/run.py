@@ -23,7 +23,7 @@ from ..io.files import prepare_outdir, read_csv
 from ..io.results import CHECKPOINT, FIELDS_HEADER
 from ..problem.analytic import AnalyticSolution
 from ..problem.drive import profile_times
-from ..problem.scene import Scene, load_scene
+from ..problem.scene import Scene
 from ..simulation.result import RunResult, reference_of
 from .animate import PANELS
 from .common import panel_axes, save_figure
@@ -197,7 +197,7 @@ def read_run(run_dir) -> RunRecord:
     if missing and not interrupted:
         raise RunDirectoryError(f"{run_dir}: not a beltsim run directory (missing "
                                 f"{', '.join(missing)})")
-    scene = load_scene(run_dir / "scene.toml")
+    scene = Scene.load(run_dir / "scene.toml")
     fields = _read_table(run_dir / "fields.csv", FIELDS_HEADER)
     if not len(fields["x"]):
         raise RunDirectoryError(f"{run_dir / 'fields.csv'}: no rows")

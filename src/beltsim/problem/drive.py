@@ -27,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .scene import profile_extremes
+from .rules import profile_extremes
 
 
 class Profile(NamedTuple):
@@ -107,7 +107,7 @@ def friction_factor(drive, t):
     return value(drive.friction, t)
 
 
-def profile_of(raw, offset: float, scale: float, ramp_time: float) -> Profile:
+def as_profile(raw, offset: float, scale: float, ramp_time: float) -> Profile:
     """(raw - offset) / scale as a Profile; numbers and sines ramp over ramp_time."""
     if isinstance(raw, list):
         rows = np.array(raw, dtype=float)
@@ -118,12 +118,17 @@ def profile_of(raw, offset: float, scale: float, ramp_time: float) -> Profile:
     return Profile.constant((raw - offset) / scale, ramp_time)
 
 
+# the name beltsim.beltdrive.run imports; that module is being rewritten, and should
+# import as_profile (a private name imported across packages)
+_profile = as_profile
+
+
 def drive_of(scene, ramp_time: float) -> Drive:
     """The scene's drive; ``ramp_time`` is the speed ramp (numerics.ramp_time)."""
     P = scene.params
     raw_speed, raw = _profiles(scene)
-    speed = profile_of(raw_speed, P.c, 1.0, ramp_time)
-    friction = Profile.constant(1.0) if raw is None else profile_of(raw, 0.0, P.fstar, 0.0)
+    speed = as_profile(raw_speed, P.c, 1.0, ramp_time)
+    friction = Profile.constant(1.0) if raw is None else as_profile(raw, 0.0, P.fstar, 0.0)
     return Drive(speed, friction)
 
 

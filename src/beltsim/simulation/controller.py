@@ -389,10 +389,9 @@ def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,
     Returns
     -------
     RunResult
-        With ``reference``, the exact steady solution, where the scene has one. A closed
-        drive (:class:`~beltsim.beltdrive.scene.DriveScene`) runs by
-        :func:`beltsim.beltdrive.simulate` and returns its
-        :class:`~beltsim.beltdrive.run.DriveResult`.
+        With ``reference``, the exact steady solution, where the scene has one.
+        :func:`beltsim.run` takes a closed drive as well, a shipped scene's name or a
+        file's path.
 
     Raises
     ------

@@ -121,15 +121,14 @@ class LoopReadout(Readout):
         return None
 
     def reference(self):
-        from ..beltdrive.analytic import solve_string
-        from ..beltdrive.beam import solve_beam
+        from ..beltdrive.beam import exact_state
 
         scene = self.disc.scene
         if any(isinstance(scene.drive[k], dict) for k in ("driver_speed", "load_torque")):
             return None  # a periodic drive never settles
         P = scene.params
         try:
-            return solve_beam(P) if P.model == "beam" else solve_string(P)
+            return exact_state(P)
         except NoSolutionError:
             return None
 

@@ -12,7 +12,7 @@ from ..physics.friction import EXACT, LINEAR, has_dual
 from ..physics.grid import Grid
 from ..physics.layout import LoopGrid, loop_mesh, loop_params
 from ..physics.model import Loads, Mesh, ModelParams, State, mesh_of, model_params
-from ..problem.drive import Drive, Profile, drive_of, profile_of
+from ..problem.drive import Drive, Profile, as_profile, drive_of
 from ..problem.scene import Scene
 from .settings import Numerics, build_grid, resolve, resolve_loop
 
@@ -105,9 +105,9 @@ class LoopDiscretisation(Discretisation):
             gyro=num.gyro_code)
         d = scene.drive
         # the rim speed omega_1(t) R_1 and the load M(t): numbers and sines ramp from 0
-        self.drive = Drive(profile_of(d["driver_speed"], 0.0, 1.0 / g.R1, num.ramp_time),
+        self.drive = Drive(as_profile(d["driver_speed"], 0.0, 1.0 / g.R1, num.ramp_time),
                            Profile.constant(1.0),
-                           profile_of(d["load_torque"], 0.0, 1.0, num.ramp_time))
+                           as_profile(d["load_torque"], 0.0, 1.0, num.ramp_time))
         self.loads: Loads = Loads.none(self.grid.n_elements)
         rim = P.omega1 * g.R1
         strain = P.N0 / P.b1

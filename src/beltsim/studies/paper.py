@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..api import paper_scene
 from ..io.files import prepare_outdir, write_csv
 from ..problem import analytic
-from ..problem.scene import paper_scene
 
 CASES = {"quasistatic": "No inertia, no slip", "inertia": "With inertia, no slip",
          "slip": "With inertia, with slip"}

@@ -16,8 +16,9 @@ import math
 from dataclasses import dataclass
 
 from .. import solvers
+from ..api import shipped_scene
 from ..errors import BeltsimError, SceneError
-from ..problem.scene import Scene, shipped_scene
+from ..problem.scene import Scene
 from ..simulation.controller import Simulation
 from ..simulation.result import RunStatus, reference_of
 from ..simulation.solution import DiscreteReference
@@ -66,7 +67,7 @@ class Case:
     """A scene of the matrix: a base scene and (key, value) overrides of it."""
 
     name: str
-    #: a shipped scene by name (problem.scene.scene_names), or a Scene
+    #: a shipped scene by name (beltsim.scene_names), or a Scene
     base: str | Scene
     overrides: tuple[tuple[str, object], ...] = ()
     #: run over this span of simulated time and ask only that the state stay bounded
