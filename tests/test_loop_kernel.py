@@ -5,11 +5,11 @@ dense ones, and the loop's steady state against the creep theory's drive engine.
 import numpy as np
 import pytest
 
+from beltsim.api import load_scene
 from beltsim.physics.friction import LAW_CODES, TANH
 from beltsim.physics.layout import LoopGrid, loop_mesh, loop_params
 from beltsim.physics.model import Loads, State, assemble
 from beltsim.problem.drive import Drive, Profile
-from beltsim.problem.scene import load_scene
 from beltsim.solvers.base import Scales
 from beltsim.solvers.newton import NewtonSettings, Workspace, factorise, linear_solve, newton
 from beltsim.solvers.ssn import saddle_solve, saddle_system

@@ -280,7 +280,7 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
         friction_scale=friction_scale, acceleration=0.0,
         steady_tol=nm.get("steady_tol", 1e-7),
         snapshot_interval=nm.get("snapshot_interval"),
-        newton_tol=nm.get("newton_tol", 1e-10),
-        newton_max_iterations=nm.get("newton_max_iterations", 40),
+        newton_tol=nm.get("newton_tol", 1e-9),
+        newton_max_iterations=nm.get("newton_max_iterations", 30),
         time_tol=nm.get("time_tol", TIME_TOLS.get(integrator, DEFAULT_TIME_TOL)),
         settle_time=settle, gyroscopic=nm.get("gyroscopic", "upwind"))
