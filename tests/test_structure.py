@@ -12,11 +12,7 @@ pytestmark = pytest.mark.unit
 SRC = ROOT / "src"
 
 #: Private names still imported across packages, each with its reason: none may be added.
-KNOWN_PRIVATE = {
-    # beltdrive/run.py is being rewritten with the drive's engine; it should import
-    # problem.drive.as_profile, the public name of the same function
-    ("beltsim.beltdrive.run", "beltsim.problem.drive", "_profile"),
-}
+KNOWN_PRIVATE: set = set()
 
 
 def _modules():

@@ -61,49 +61,6 @@ def _drive_analytic(args, scene):
     return 0
 
 
-def _drive_run(args, scene):
-    from pathlib import Path
-
-    from .beltdrive.io import format_drive, result_summary, save_drive_run
-    from .beltdrive.run import DriveStatus, simulate
-
-    out = Path(args.out or Path("runs/out") / Path(args.scene).stem)
-    bar = progress = None
-    if _progress(args):
-        from tqdm.auto import tqdm
-
-        from .beltdrive.run import resolve
-
-        bar = tqdm(total=resolve(scene).t_end, unit="s", desc="simulated time",
-                   bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}]")
-
-        def progress(t, t_end):
-            bar.update(t - bar.n)
-    try:
-        result = simulate(scene, progress=progress, snapshot_interval=args.snapshots
-                          or scene.numerics.get("snapshot_interval"))
-    finally:
-        if bar is not None:
-            bar.close()
-    save_drive_run(result, out)
-    summary = result_summary(result)
-    print(format_drive(summary, title=scene.title or args.scene))
-    print(f"  status           {summary['status']} after {summary.get('steps', 0)} steps, "
-          f"wall {summary['wall_time']:.3g} s")
-    if summary["error"]:
-        print("  error vs exact   " + ", ".join(f"{k} {v:.2e}" for k, v in
-                                              summary["error"].items()))
-    written = ["summary.json", "fields.csv"] + (["history.csv"] if result.history else [])
-    print(f"wrote {out}/" + ", ".join(written))
-    if result.status is DriveStatus.FAILED:
-        print(f"beltsim: numerical failure: {result.reason}", file=sys.stderr)
-        return 3
-    if result.status is not DriveStatus.CONVERGED:
-        print(f"beltsim: {result.status.value}: {result.reason}", file=sys.stderr)
-        return 1
-    return 0
-
-
 def _progress(args) -> bool:
     """A progress bar unless --quiet, and only on a terminal: not in a captured log."""
     return not args.quiet and sys.stderr.isatty()
@@ -133,7 +90,10 @@ def cmd_analytic(args):
 
 
 def format_summary(summary: dict, title: str = "") -> str:
-    """A short human-readable table of a summary dict."""
+    """A short human-readable table of a summary dict (a drive's: its figures)."""
+    if "tight_tension" in summary:
+        from .beltdrive.io import format_drive
+        return format_drive(summary, title)
     rows = [("model", summary["model"]), ("inertia", str(summary["inertia"]).lower())]
     for key, unit in (("total_friction", "N"), ("concentrated_force", "N"),
                       ("distributed_friction", "N"), ("stick_friction", "N"),
@@ -153,7 +113,6 @@ def cmd_run(args):
     from .io.files import prepare_outdir
     from .io.results import CHECKPOINT, save_run
     from .simulation.controller import Simulation
-    from .simulation.result import reference_of
 
     if args.snapshots is not None and not args.snapshots > 0:
         raise UsageError(f"--snapshots: must be > 0 s, got {args.snapshots}")
@@ -167,8 +126,6 @@ def cmd_run(args):
         if not args.scene:
             raise UsageError("run: give a SCENE file, or --resume DIR")
         scene = _scene(args)
-        if _is_drive(scene):
-            return _drive_run(args, scene)
         sim = Simulation(scene, snapshot_interval=args.snapshots)
         out = prepare_outdir(args.out or Path("runs/out") / Path(args.scene).stem)
         title = scene.title or args.scene
@@ -181,7 +138,7 @@ def cmd_run(args):
         print(f"beltsim: {result.reason}; state so far and checkpoint written, continue with "
               f"'beltsim run --resume {out}'", file=sys.stderr)
         return 130
-    result.reference = reference_of(sim.scene)
+    result.reference = sim.readout.reference()
     save_run(result, out)
     summary = result.summary()
     print(format_summary(summary, title=title))
@@ -341,9 +298,9 @@ def _drive_sweep(args, scene, key, values):
     import numpy as np
 
     from .beltdrive import plots
-    from .beltdrive.run import SUMMARY_KEYS
     from .io.files import prepare_outdir, write_csv
     from .plots.common import save_figure
+    from .simulation.loop_solution import SUMMARY_KEYS
     from .studies import sweep
 
     out = prepare_outdir(args.out or Path("runs/out") / f"sweep_{Path(args.scene).stem}")
@@ -405,27 +362,9 @@ def _stored_drive(run_dir, is_drive) -> bool:
         return False  # the straight belt's reader says what is wrong
 
 
-def _drive_animate(args, scene=None):
-    from pathlib import Path
+def _drive_animate(args, out, src):
+    from .beltdrive.io import animate_drive_run
 
-    from .beltdrive.io import animate_drive_run, save_drive_run
-    from .beltdrive.run import simulate, transit_time
-    from .io.files import prepare_outdir
-
-    if scene is None:
-        src = Path(args.from_dir)
-        out = prepare_outdir(args.out or src)
-    else:
-        interval = args.interval or scene.numerics.get("snapshot_interval") or \
-            transit_time(scene.params) / 8
-        if not interval > 0:
-            raise UsageError(f"--interval: must be > 0 s, got {interval}")
-        out = prepare_outdir(args.out or Path("runs/out") / f"animate_{Path(args.scene).stem}")
-        result = simulate(scene, snapshot_interval=interval)
-        save_drive_run(result, out)
-        print(f"ran {args.scene}: {result.status.value} at t = {result.history['t'][-1]:.4g} "
-              f"s, {len(result.snapshots['t'])} snapshots")
-        src = out
     path = animate_drive_run(src, out / f"transient.{args.format}", args.fps)
     print(f"wrote {path}")
     return 0
@@ -446,18 +385,19 @@ def cmd_animate(args):
             raise UsageError("--from DIR animates a stored run: give no SCENE or --set")
         from .beltdrive.scene import is_drive
 
-        if _stored_drive(Path(args.from_dir), is_drive):
-            return _drive_animate(args)
         src = Path(args.from_dir)
         out = prepare_outdir(args.out or src)
+        if _stored_drive(src, is_drive):
+            return _drive_animate(args, out, src)
     else:
         if not args.scene:
             raise UsageError("animate: give a SCENE file, or --from DIR")
         scene = _scene(args)
-        if _is_drive(scene):
-            return _drive_animate(args, scene)
-        P = scene.params
-        interval = args.interval or scene.numerics.get("snapshot_interval") or P.L / (4 * P.c)
+        from .solvers import discretise
+
+        window = discretise(scene).window
+        interval = args.interval or scene.numerics.get("snapshot_interval") or window / (
+            8 if _is_drive(scene) else 4)
         if not interval > 0:
             raise UsageError(f"--interval: must be > 0 s, got {interval}")
         out = prepare_outdir(args.out or Path("runs/out") / f"animate_{Path(args.scene).stem}")
@@ -467,6 +407,8 @@ def cmd_animate(args):
         print(f"ran {args.scene}: {'steady' if result.converged else result.reason} at "
               f"t = {result.simulated_time:.4g} s, {len(result.snapshots['t'])} snapshots")
         src = out
+        if _is_drive(scene):
+            return _drive_animate(args, out, src)
     if not (src / SNAPSHOTS).is_file():
         raise UsageError(f"--from {src}: no {SNAPSHOTS} there (run with --snapshots INTERVAL)")
     path = animate(src / SNAPSHOTS, out / f"transient.{args.format}", args.format, args.fps)

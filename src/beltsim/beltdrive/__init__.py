@@ -8,15 +8,18 @@ and the driven pulley's speed omega2(t) are unknowns of the loop. A few lines::
     from beltsim import beltdrive
     scene = beltsim.load_scene("drive_flat")          # a DriveScene
     print(beltdrive.solve_string(scene.params).summary())   # the creep theory
-    result = beltdrive.simulate(scene)                # from rest to steady state
-    print(result.status, result.summary["speed_ratio"], result.errors())
+    result = beltsim.run(scene)                       # from rest, by the one engine
+    print(result.status, result.summary()["speed_ratio"], result.errors())
+
+This package holds the drive's problem: its scene, geometry and exact steady states
+(the creep theory, the beam's), and its drawings. It is solved as a closed layout of
+the one discrete model (:mod:`beltsim.physics.layout`, :mod:`beltsim.solvers`).
 """
 
 from .analytic import GrossSlipError, LiftOffError, StringSolution, capacity, solve_string
+from .beam import exact_state
 from .geometry import Geometry
-from .run import DriveResult, DriveStatus, simulate, solve_steady
 from .scene import DriveParams, DriveScene
 
-__all__ = ["DriveParams", "DriveResult", "DriveScene", "DriveStatus", "Geometry",
-           "GrossSlipError", "LiftOffError", "StringSolution", "capacity", "simulate",
-           "solve_steady", "solve_string"]
+__all__ = ["DriveParams", "DriveScene", "Geometry", "GrossSlipError", "LiftOffError",
+           "StringSolution", "capacity", "exact_state", "solve_string"]

@@ -1,55 +1,16 @@
-"""Files of a drive's run or analytic solution: summary.json, fields.csv, history.csv."""
+"""A drive's stored run read back (summary.json, fields.csv, history.csv, snapshots.npz,
+as :func:`beltsim.io.results.save_run` writes them), drawn and animated; its figures as
+text."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from ..errors import NoSolutionError
-from ..io.files import prepare_outdir, write_atomic, write_csv, write_json
-from .run import DriveResult
+from ..io.files import prepare_outdir
 
 #: the snapshots of a run (``beltsim run --snapshots``), for ``beltsim animate --from``
 SNAPSHOTS = "snapshots.npz"
-#: nodal fields written to fields.csv, after x
-FIELD_KEYS = ("u", "theta", "tension", "friction", "pressure", "slip_velocity", "slip")
-
-
-def power_balance(summary: dict) -> float:
-    """driver - load - slip - damping - gyroscopic + transport power (W) of a summary:
-    the rate of the stored energy (run.power_terms), zero at a steady state."""
-    return float(summary["driver_power"] - summary["load_power"] - summary["slip_power"]
-                 - summary["damping_power"] - summary["gyroscopic_power"]
-                 + summary["transport_power"])
-
-
-def result_summary(result: DriveResult) -> dict:
-    """The summary.json of a run: status, figures, errors against the analytic state."""
-    ana = result.analytic.summary() if result.analytic is not None else None
-    return {
-        "title": result.scene.title, "kind": "closed drive",
-        "model": result.scene.params.model, "status": result.status.value,
-        "converged": result.converged, "reason": result.reason,
-        "integrator": result.numerics.integrator, "elements": result.numerics.elements,
-        **{k: float(v) for k, v in result.summary.items()},
-        # zero at a steady state to the grid's error (the stored energy's rate otherwise)
-        "power_balance": power_balance(result.summary),
-        "analytic": ana, "error": result.errors() or None,
-        "wall_time": result.wall_time, **result.statistics,
-    }
-
-
-def save_drive_run(result: DriveResult, out) -> None:
-    """Write summary.json, fields.csv, history.csv and scene.toml of a run into ``out``."""
-    out = prepare_outdir(out)
-    write_json(out / "summary.json", result_summary(result))
-    cols = [result.x] + [np.asarray(result.fields[k], dtype=float) for k in FIELD_KEYS]
-    write_csv(out / "fields.csv", ("x",) + FIELD_KEYS, cols)
-    if result.history:
-        keys = tuple(result.history)
-        write_csv(out / "history.csv", keys, [result.history[k] for k in keys])
-    write_atomic(out / "scene.toml", result.scene.to_toml())
-    if result.snapshots and len(result.snapshots.get("t", ())):
-        np.savez_compressed(out / SNAPSHOTS, x=result.x, **result.snapshots)
 
 
 def format_drive(summary: dict, title: str = "") -> str:
@@ -96,13 +57,13 @@ def plot_drive_run(run_dir, out=None) -> list:
 
     from ..plots.common import save_figure
     from . import plots
-    from .run import analytic_of
+    from .beam import exact_state
 
     scene, x, f, hist, summary = read_drive_run(run_dir)
     out = prepare_outdir(out or run_dir)
     g = scene.params.geometry
     try:
-        ana = analytic_of(scene.params)
+        ana = exact_state(scene.params)
     except NoSolutionError:  # no steady state (gross slip): the run's own fields only
         ana = None
     paths = [save_figure(plots.draw_drive, out / "drive.png", g, x, f["tension"],

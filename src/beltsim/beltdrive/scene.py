@@ -89,7 +89,7 @@ SCHEMA: dict[str, dict[str, Rule]] = {
         "model": Rule("str", choices=("beam", "string")),
     },
     "numerics": {
-        "integrator": Rule("str", choices=("implicit", "explicit", "steady")),
+        "integrator": Rule("str"),  # a registered scheme: beltsim.solvers checks it
         "elements": Rule("int", minimum=4 * MIN_SEGMENT_ELEMENTS),
         "dt": POS,
         "t_end": POS,
@@ -101,6 +101,7 @@ SCHEMA: dict[str, dict[str, Rule]] = {
         "newton_tol": POS,
         "newton_max_iterations": Rule("int", minimum=1),
         "snapshot_interval": POS,
+        "gyroscopic": Rule("str", choices=("upwind", "central")),
     },
 }
 REQUIRED = {"belt": ("height", "width", "youngs_modulus", "poisson_ratio", "shear_factor"),

@@ -13,7 +13,6 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SceneError
-from ..physics.model import traction
 from ..problem.scene import Scene
 from .files import OutputError, prepare_outdir, write_atomic, write_csv, write_json
 
@@ -22,9 +21,11 @@ SNAPSHOTS = "snapshots.npz"
 CHECKPOINT = "checkpoint.npz"
 
 
-def write_fields(path, x, fields: dict) -> Path:
-    """Write fields.csv: x and the fields of FIELDS_HEADER."""
-    return write_csv(path, FIELDS_HEADER, [x] + [fields[k] for k in FIELDS_HEADER[1:]])
+def write_fields(path, x, fields: dict, keys=FIELDS_HEADER[1:]) -> Path:
+    """Write fields.csv: x and the fields ``keys`` (default FIELDS_HEADER's, the paper's
+    belt; a drive's run writes its own)."""
+    return write_csv(path, ("x", *keys), [x] + [np.asarray(fields[k], dtype=float)
+                                                 for k in keys])
 
 
 def save_run(result, out, complete: bool = True) -> list[Path]:
@@ -39,7 +40,7 @@ def save_run(result, out, complete: bool = True) -> list[Path]:
     sol = result.solution
     keys = tuple(result.history)
     paths = [
-        write_fields(out / "fields.csv", sol.x, sol.fields()),
+        write_fields(out / "fields.csv", sol.x, sol.fields(), tuple(sol.fields())),
         write_csv(out / "history.csv", keys, [result.history[k] for k in keys]),
         write_atomic(out / "scene.toml", result.scene.to_toml()),
     ]
@@ -54,16 +55,17 @@ def save_run(result, out, complete: bool = True) -> list[Path]:
 def write_snapshots(path, result) -> Path:
     """States at every snapshot interval, compressed, in single precision.
 
-    Arrays: ``x`` (nodes), ``t`` (times), ``u``, ``theta``, ``friction`` (the traction
-    in N/m at the friction nodes, as in fields.csv), each (times, nodes);
-    ``scene`` (the scene as TOML text). Single precision keeps a long run's file small
-    and is far finer than a plot.
+    Arrays: ``x`` (nodes), ``t`` (times) and the layout's fields, each (times, nodes)
+    (``result.solution.snapshot_arrays``): ``u``, ``theta``, ``friction`` (the traction in
+    N/m at the friction nodes, as in fields.csv) and, for a drive, ``tension``, ``slip``
+    and the speeds ``belt_speed``, ``driven_speed`` (times); ``scene`` (the scene as TOML
+    text). Single precision keeps a long run's file small and is far finer than a plot.
     """
     sol, snaps = result.solution, result.snapshots
+    arrays = {k: np.asarray(v).astype(np.float32) if np.asarray(v).dtype.kind == "f" else v
+              for k, v in sol.snapshot_arrays(snaps).items()}
     buf = io.BytesIO()
-    np.savez_compressed(buf, x=sol.x, t=snaps["t"], u=snaps["u"].astype(np.float32),
-                        theta=snaps["theta"].astype(np.float32),
-                        friction=traction(snaps["fnode"], sol.wf).astype(np.float32),
+    np.savez_compressed(buf, x=sol.x, t=snaps["t"], **arrays,
                         scene=np.array(result.scene.to_toml()))
     return write_atomic(path, buf.getvalue())
 

@@ -118,11 +118,6 @@ def as_profile(raw, offset: float, scale: float, ramp_time: float) -> Profile:
     return Profile.constant((raw - offset) / scale, ramp_time)
 
 
-# the name beltsim.beltdrive.run imports; that module is being rewritten, and should
-# import as_profile (a private name imported across packages)
-_profile = as_profile
-
-
 def drive_of(scene, ramp_time: float) -> Drive:
     """The scene's drive; ``ramp_time`` is the speed ramp (numerics.ramp_time)."""
     P = scene.params

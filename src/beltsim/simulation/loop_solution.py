@@ -48,6 +48,7 @@ class LoopSolution:
 
     def __init__(self, disc, state, t=None):
         self.params = disc.params
+        self.disc = disc
         self.mesh = m = disc.mesh
         self.numerics = disc.numerics
         self.x = disc.grid.x.copy()
@@ -212,6 +213,25 @@ class LoopSolution:
         if path:
             out.update(omega1=omega1, load_torque=self.load)
         return out
+
+    def snapshot_arrays(self, snaps: dict) -> dict:
+        """What snapshots.npz holds of a run's snapshots: u, theta, the traction, the
+        axial force and the sliding nodes (times, nodes), and the belt's and the driven
+        pulley's speeds (times)."""
+        from ..physics.model import State
+
+        out = {k: [] for k in ("u", "theta", "friction", "tension", "slip", "belt_speed",
+                               "driven_speed")}
+        N = len(self.x)
+        for i in range(len(snaps["t"])):
+            st = State(snaps["u"][i], snaps["theta"][i], snaps["lam"][i], np.zeros(N),
+                       np.zeros(N), snaps["fnode"][i], snaps["g"][i], np.zeros(2))
+            f = LoopSolution(self.disc, st, snaps["t"][i])._fields
+            for k in ("u", "theta", "friction", "tension", "slip"):
+                out[k].append(f[k])
+            out["belt_speed"].append(st.g[0])
+            out["driven_speed"].append(st.g[1])
+        return {k: np.array(v) for k, v in out.items()}
 
     # outcomes ---------------------------------------------------------
     def lift_off(self) -> str | None:

@@ -168,7 +168,8 @@ class RunResult:
             (:meth:`errors`).
         """
         out = self.solution.summary()
-        out.update(converged=self.converged, simulated_time=self.simulated_time,
+        out.update(status=self.status.value, converged=self.converged,
+                   simulated_time=self.simulated_time,
                    steps=self.steps, rejected_steps=self.statistics.get("rejected_steps", 0),
                    time_accurate=self.time_accurate, wall_time=self.wall_time,
                    compile_time=self.compile_time,

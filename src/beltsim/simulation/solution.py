@@ -89,6 +89,11 @@ class DiscreteSolution:
         """The errors against the exact steady state ``ref`` (:func:`compare`)."""
         return compare(self, ref)
 
+    def snapshot_arrays(self, snaps: dict) -> dict:
+        """What snapshots.npz holds of a run's snapshots: u, theta and the traction (N/m)."""
+        return {"u": snaps["u"], "theta": snaps["theta"],
+                "friction": traction(snaps["fnode"], self.wf)}
+
     def fields(self) -> dict:
         """Nodal fields with the analytic header: strain and moment averaged from elements."""
         he = self.grid.he

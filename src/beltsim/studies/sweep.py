@@ -41,13 +41,15 @@ def run_drive_point(scene_dict: dict, key: str, value) -> dict:
     """One sweep point of a closed drive: its run from rest and its analytic steady state
     (none beyond the capacity: gross slip is then the run's expected outcome)."""
     from ..beltdrive.analytic import capacity
-    from ..beltdrive.run import SUMMARY_KEYS, simulate
     from ..beltdrive.scene import DriveScene
+    from ..simulation.controller import run
+    from ..simulation.loop_solution import SUMMARY_KEYS
 
     scene = DriveScene(scene_dict).with_overrides([(key, value)])
-    res = simulate(scene)
-    row = {"value": value, **{k: res.summary[k] for k in SUMMARY_KEYS}}
-    exact = res.analytic.summary() if res.analytic is not None else {}
+    res = run(scene, raise_on_failure=False)
+    summary = res.solution.summary()
+    row = {"value": value, **{k: summary[k] for k in SUMMARY_KEYS}}
+    exact = res.reference.summary() if res.reference is not None else {}
     row.update({f"{k}_analytic": exact.get(k) for k in SUMMARY_KEYS})
     row.update(status=res.status.value, converged=res.converged, wall_time=res.wall_time,
                reason=res.reason, capacity=capacity(scene.params))
