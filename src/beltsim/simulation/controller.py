@@ -390,7 +390,7 @@ def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,
     RunResult
         With ``reference``, the exact steady solution, where the scene has one. A closed
         drive (:class:`~beltsim.beltdrive.scene.DriveScene`) runs by
-        :func:`beltsim.beltdrive.simulate` and returns its
+        :func:`beltsim.beltdrive.run.simulate` and returns its
         :class:`~beltsim.beltdrive.run.DriveResult`.
 
     Raises
