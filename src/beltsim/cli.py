@@ -487,6 +487,30 @@ def cmd_plot(args):
     return 0
 
 
+def cmd_scenes(args):
+    from .errors import MissingInputError
+    from .problem.scene import scene_names, shipped_scene
+
+    names = scene_names()
+    if not names:
+        raise MissingInputError("no scenes ship with this installation of beltsim")
+    rows = [(name, *_scene_kind(shipped_scene(name))) for name in names]
+    width = max(len(name) for name, *_ in rows)
+    kind_width = max(len(kind) for _, kind, _ in rows)
+    for name, kind, title in rows:
+        print(f"{name:<{width}}  {kind:<{kind_width}}  {title}")
+    return 0
+
+
+def _scene_kind(scene) -> tuple[str, str]:
+    """A shipped scene's kind (closed drive or straight belt, and its friction) and title."""
+    if _is_drive(scene):
+        return "closed drive", scene.title
+    friction = {"stick": "perfect adhesion", "coulomb": "stick and slip"}
+    return f"straight belt, {friction.get(scene.contact.friction, scene.contact.friction)}", \
+        scene.title
+
+
 def _int_list(text, name):
     from .problem.scene import MIN_ELEMENTS
 
@@ -512,7 +536,14 @@ def _cell(v):
 def build_parser():
     parser = OneLineParser(prog="beltsim", description="Belt-drive contact mechanics: analytic "
                      "steady solutions and transient Eulerian simulation.")
+    from . import __version__
+
+    parser.add_argument("--version", action="version", version=f"beltsim {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
+    p = sub.add_parser("scenes", help="the shipped scenes: name, kind and title (run one "
+                       "with 'beltsim run NAME')")
+    p.set_defaults(func=cmd_scenes)
+
     p = sub.add_parser("analytic", help="analytic steady solution of a scene")
     _add_scene_args(p)
     p.add_argument("--out", default="runs/out/analytic", help="output directory")
