@@ -70,12 +70,11 @@ def _drive_run(args, scene):
     out = Path(args.out or Path("runs/out") / Path(args.scene).stem)
     bar = progress = None
     if _progress(args):
-        from tqdm.auto import tqdm
-
         from .beltdrive.run import resolve
+        from .simulation.trackers import progress_bar
 
-        bar = tqdm(total=resolve(scene).t_end, unit="s", desc="simulated time",
-                   bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}]")
+        bar = progress_bar(total=resolve(scene).t_end, unit="s", desc="simulated time",
+                           bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}]")
 
         def progress(t, t_end):
             bar.update(t - bar.n)
