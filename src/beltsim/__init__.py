@@ -17,9 +17,6 @@ from .errors import (
     NumericalError,
     SceneError,
 )
-from .io.results import save_run
-from .plots.run import plot_fields, plot_history
-from .problem.analytic import AnalyticSolution, solve
 from .problem.builder import (
     Beam,
     Contact,
@@ -30,11 +27,38 @@ from .problem.builder import (
     Stiffness,
 )
 from .problem.scene import Scene, load_scene, paper_scene, scene_names, shipped_scene
-from .simulation.controller import Simulation, run
-from .simulation.result import RunResult, RunStatus
-from .simulation.trackers import Stop, Tracker
 
 __version__ = "0.1.0"
+
+# Imported on first use: they bring numba, scipy.optimize and matplotlib, a second of
+# `import beltsim` that listing scenes or building one does not need.
+_LAZY = {
+    "save_run": "io.results", "plot_fields": "plots.run", "plot_history": "plots.run",
+    "AnalyticSolution": "problem.analytic", "solve": "problem.analytic",
+    "Simulation": "simulation.controller", "run": "simulation.controller",
+    "RunResult": "simulation.result", "RunStatus": "simulation.result",
+    "Stop": "simulation.trackers", "Tracker": "simulation.trackers",
+}
+
+
+_SUBPACKAGES = ("beltdrive", "cli", "io", "physics", "plots", "problem", "simulation",
+                "solvers", "studies")
+
+
+def __getattr__(name):
+    import importlib
+
+    if name in _SUBPACKAGES:  # beltsim.solvers.settings... after a bare `import beltsim`
+        return importlib.import_module(f".{name}", __name__)
+    if name not in _LAZY:
+        raise AttributeError(f"module 'beltsim' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    globals()[name] = value  # once: later lookups skip this function
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
 
 __all__ = [
     "AnalyticSolution", "Beam", "BeltsimError", "Contact", "MissingInputError", "Motion",

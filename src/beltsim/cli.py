@@ -32,8 +32,10 @@ def _scene(args):
 
 
 def _is_drive(scene) -> bool:
-    from .beltdrive.scene import DriveScene
-    return isinstance(scene, DriveScene)
+    # a drive scene exists only once its module is loaded; importing it costs a straight
+    # belt's command a third of a second
+    drive = sys.modules.get("beltsim.beltdrive.scene")
+    return drive is not None and isinstance(scene, drive.DriveScene)
 
 
 def _straight_only(args, scene):
@@ -196,9 +198,13 @@ def cmd_run(args):
 
 
 def format_run(summary: dict) -> str:
+    from .simulation.controller import COMPILING_AFTER
+
+    kernels = summary.get("compile_time") or 0.0
     lines = [f"  converged       {str(summary['converged']).lower()} after "
              f"{summary['steps']} steps, t = {summary['simulated_time']:.4g} s, "
-             f"wall {summary['wall_time']:.3g} s"]
+             f"wall {summary['wall_time']:.3g} s (+ {kernels:.2g} s "
+             f"{'compiling' if kernels > COMPILING_AFTER else 'loading'} the kernels)"]
     per = summary.get("periodic")
     if per:
         for key, part in per.items():

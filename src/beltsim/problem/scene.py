@@ -910,10 +910,13 @@ def shipped_scene(name: str, overrides=()) -> Scene:
 
 def _loads_any(text: str, source: str):
     """A Scene, or a DriveScene where the text has a [drive] section (a closed drive)."""
-    from ..beltdrive.scene import DriveScene, is_drive
-
     data = parse_toml(text, source)
-    return DriveScene(data, source=source) if is_drive(data) else Scene(data, source=source)
+    # beltdrive.scene.is_drive, without importing beltdrive (numba, scipy) for a straight belt
+    if isinstance(data, dict) and "drive" in data:
+        from ..beltdrive.scene import DriveScene
+
+        return DriveScene(data, source=source)
+    return Scene(data, source=source)
 
 
 def load_scene(path_or_name, overrides=()) -> Scene:
