@@ -36,3 +36,19 @@ def test_scenes_without_shipped_scenes_is_a_one_line_error(monkeypatch, capsys):
     assert cli_module.main(["scenes"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "no scenes ship" in err
+
+
+@pytest.mark.cli
+def test_analytic_writes_a_folder_of_its_own_scene_and_clears_what_it_did_not_write(tmp_path):
+    from helpers import cli
+
+    proc = cli("analytic", "paper_slip", cwd=tmp_path, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    own = tmp_path / "runs" / "out" / "analytic_paper_slip"
+    assert {p.name for p in own.iterdir()} == {"summary.json", "fields.csv"}
+    # a drive's analytic solution has no fields.csv: the straight belt's one goes
+    proc = cli("analytic", "drive_flat", "--set", "physics.model=string", "--out", own,
+               cwd=tmp_path, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert {p.name for p in own.iterdir()} == {"summary.json"}
+    assert "slip_arc_driver" in (own / "summary.json").read_text()
