@@ -9,6 +9,9 @@ from __future__ import annotations
 import argparse
 import sys
 
+from .cli_text import cell as _cell
+from .cli_text import format_run, format_summary
+from .cli_text import int_list as _int_list
 from .errors import BeltsimError, NumericalError, UsageError
 
 
@@ -153,21 +156,6 @@ def cmd_analytic(args):
     return 0
 
 
-def format_summary(summary: dict, title: str = "") -> str:
-    """A short human-readable table of a summary dict."""
-    rows = [("model", summary["model"]), ("inertia", str(summary["inertia"]).lower())]
-    for key, unit in (("total_friction", "N"), ("concentrated_force", "N"),
-                      ("distributed_friction", "N"), ("stick_friction", "N"),
-                      ("slip_friction", "N"), ("slip_start", "m"), ("slip_power", "W")):
-        value = summary.get(key)
-        if value is not None:
-            rows.append((key, f"{value:.6g} {unit}"))
-    width = max(len(k) for k, _ in rows)
-    lines = [title] if title else []
-    lines += [f"  {k:<{width}}  {v}" for k, v in rows]
-    return "\n".join(lines)
-
-
 def cmd_run(args):
     from pathlib import Path
 
@@ -215,27 +203,6 @@ def cmd_run(args):
         print(f"beltsim: warning: {result.reason}", file=sys.stderr)
         return 1
     return 0
-
-
-def format_run(summary: dict) -> str:
-    from .simulation.controller import COMPILING_AFTER
-
-    kernels = summary.get("compile_time") or 0.0
-    lines = [f"  converged       {str(summary['converged']).lower()} after "
-             f"{summary['steps']} steps, t = {summary['simulated_time']:.4g} s, "
-             f"wall {summary['wall_time']:.3g} s (+ {kernels:.2g} s "
-             f"{'compiling' if kernels > COMPILING_AFTER else 'loading'} the kernels)"]
-    per = summary.get("periodic")
-    if per:
-        for key, part in per.items():
-            if isinstance(part, dict):
-                lines.append(f"  last period     {key} min {part['min']:.6g}, mean "
-                             f"{part['mean']:.6g}, max {part['max']:.6g}")
-    err = summary.get("error")
-    if err:
-        parts = [f"{k} {v:.2e}" for k, v in err.items() if v is not None]
-        lines.append("  error vs exact  " + ", ".join(parts) + " (slip_start in m)")
-    return "\n".join(lines)
 
 
 def cmd_convergence(args):
@@ -466,6 +433,10 @@ def cmd_animate(args):
 
     if args.fps < 1:
         raise UsageError(f"--fps: must be >= 1, got {args.fps}")
+    if args.format is None:
+        from .plots.animate import ffmpeg_available
+
+        args.format = "mp4" if ffmpeg_available() else "gif"
     if args.from_dir:
         if args.scene or args.overrides:
             raise UsageError("--from DIR animates a stored run: give no SCENE or --set")
@@ -536,28 +507,6 @@ def _scene_kind(scene) -> tuple[str, str]:
         scene.title
 
 
-def _int_list(text, name):
-    from .problem.scene import MIN_ELEMENTS
-
-    try:
-        vals = [int(v) for v in text.split(",")]
-    except ValueError:
-        raise UsageError(f"{name}: expected comma-separated whole numbers, got {text!r}") from None
-    if any(v < MIN_ELEMENTS for v in vals):
-        raise UsageError(f"{name}: every grid needs at least {MIN_ELEMENTS} elements")
-    return vals
-
-
-def _cell(v):
-    if isinstance(v, str):
-        return f"{v:>12s}"
-    if isinstance(v, bool):
-        return f"{str(v).lower():>12s}"
-    if isinstance(v, int):
-        return f"{v:>12d}"
-    return f"{v:>12.4g}"
-
-
 def build_parser():
     parser = OneLineParser(prog="beltsim", description="Belt-drive contact mechanics: analytic "
                      "steady solutions and transient Eulerian simulation.")
@@ -609,7 +558,8 @@ def build_parser():
     p.add_argument("--from", dest="from_dir", metavar="DIR", default=None,
                    help="animate DIR/snapshots.npz of a stored run, without running")
     p.add_argument("--out", default=None, help="output directory")
-    p.add_argument("--format", choices=("gif", "mp4"), default="gif")
+    p.add_argument("--format", choices=("gif", "mp4"), default=None,
+                   help="mp4 where ffmpeg is at hand (imageio-ffmpeg ships one), else gif")
     p.add_argument("--fps", type=int, default=15, help="frames per second")
     p.add_argument("--interval", type=float, default=None,
                    help="simulated seconds between snapshots (default L / (4 c))")
