@@ -399,8 +399,8 @@ def time_path(page: Page, quick: bool) -> None:
 
 def build(page: Page, quick: bool) -> None:
     page.para(
-        f"The shipped `{SCENE}` scene (a flat belt on pulleys of radius R = 80 / 160 mm, 150 rad/s, "
-        "50 N m, mu = 0.4) against the string's creep theory, the analytic steady state "
+        f"The shipped `{SCENE}` scene (a flat belt on pulleys of radius R = 80 / 160 mm, "
+        "150 rad/s, 50 N m, mu = 0.4) against the string's creep theory, the analytic steady state "
         "derived on the [theory page](../theory/drive.md). Every table is computed "
         "through beltsim's API; the commands give the same runs from the command line. "
         "Wall times exclude compilation.")
