@@ -166,7 +166,7 @@ class Simulation:
     def warm_up(self, notice: bool = False) -> float:
         """Compile (or load from numba's cache) the kernels; returns the seconds it took.
 
-        With ``notice``, a warm-up still going after :data:`COMPILING_AFTER` seconds says
+        With ``notice``, a warm-up still going after ``COMPILING_AFTER`` seconds says
         on stderr that it compiles (the first run after an install waits that long).
         """
         timer = threading.Timer(COMPILING_AFTER, print, (COMPILE_NOTICE,),
