@@ -2,8 +2,9 @@
 A closed drive: start-up to the rated load
 ==========================================
 
-The shipped ``drive_flat`` scene is a flat-belt drive: a 60 mm x 4 mm belt on an 80 mm
-driver and a 160 mm driven pulley, 0.6 m apart, pretensioned to 600 N, with mu = 0.4.
+The shipped ``drive_flat`` scene is a flat-belt drive: a 60 mm x 4 mm belt on a driver
+and a driven pulley of radius R = 80 / 160 mm, 0.6 m apart, pretensioned to 600 N, with
+mu = 0.4.
 The run starts at rest (no belt speed, uniform tension); the driver's speed and the
 load ramp smoothly to 150 rad/s and 50 N m, and the run goes on until the drive is
 steady, then compares its state with the analytic steady state. The same from the

@@ -5,7 +5,7 @@ The beam's rotation as friction grows: the drive's Fig. 7
 The paper's Fig. 7 shows the belt's rotation theta for three friction limits f*: as f*
 grows, the slip zone shrinks onto the contact's exit and theta tends to the
 perfect-adhesion solution. This is the same picture for the closed drive, from the
-beam's exact steady state (:func:`beltsim.beltdrive.beam.solve_beam`) at friction
+beam's exact steady state (``beltsim.beltdrive.beam.solve_beam``) at friction
 coefficients mu = 0.4, 2 and 10 and for perfect adhesion, around the driver's arc (left)
 and the driven arc (right); the markers are the discrete steady state at mu = 0.4 on the
 default grid. The rotation is small (the friction's moment (h/2) f over a 4 mm belt), and

@@ -12,19 +12,25 @@ from helpers import cli, scene_path
 pytestmark = pytest.mark.cli
 
 
-def test_animate_runs_and_stores_a_gif_then_mp4_from_the_stored_run(tmp_path):
+def test_animate_runs_and_stores_an_mp4_then_a_gif_from_the_stored_run(tmp_path):
     run_dir = tmp_path / "run"
     proc = cli("animate", scene_path("paper_slip"), "--set", "numerics.elements=150",
                 "--interval", "0.05", "--fps", "5", "--out", str(run_dir), "--quiet")
     assert proc.returncode == 0, proc.stderr
-    gif = Image.open(run_dir / "transient.gif")
-    assert gif.n_frames > 5
-    stamp = (run_dir / "summary.json").stat().st_mtime_ns
-    out = tmp_path / "mp4"
-    proc = cli("animate", "--from", str(run_dir), "--format", "mp4", "--out", str(out))
-    assert proc.returncode == 0, proc.stderr
-    data = (out / "transient.mp4").read_bytes()
+    # MP4 by default: imageio-ffmpeg, a dependency, ships ffmpeg
+    data = (run_dir / "transient.mp4").read_bytes()
     assert len(data) > 10_000 and data[4:8] == b"ftyp"
+    stamp = (run_dir / "summary.json").stat().st_mtime_ns
+    out = tmp_path / "gif"
+    proc = cli("animate", "--from", str(run_dir), "--format", "gif", "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    gif = Image.open(out / "transient.gif")
+    assert gif.n_frames > 5
+    # every frame has the time stamp above the top panel (drawn over a fixed background)
+    gif.seek(gif.n_frames - 1)
+    # rows 18-34 of the 640 x 760 frame: below the figure's title, above the top panel
+    band = np.asarray(gif.convert("L"))[18:34]
+    assert (band < 128).sum() > 200  # measured about 670 dark pixels of text
     assert (run_dir / "summary.json").stat().st_mtime_ns == stamp  # no new run
 
 

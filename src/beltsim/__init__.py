@@ -10,7 +10,6 @@ A few lines do what the CLI does::
     beltsim.save_run(result, "runs/out/slip")
 """
 
-from .api import load_scene, paper_scene, run, scene_names, shipped_scene, solve
 from .errors import (
     BeltsimError,
     MissingInputError,
@@ -18,9 +17,6 @@ from .errors import (
     NumericalError,
     SceneError,
 )
-from .io.results import save_run
-from .plots.run import plot_fields, plot_history
-from .problem.analytic import AnalyticSolution
 from .problem.builder import (
     Beam,
     Contact,
@@ -31,11 +27,40 @@ from .problem.builder import (
     Stiffness,
 )
 from .problem.scene import Scene
-from .simulation.controller import Simulation
-from .simulation.result import RunResult, RunStatus
-from .simulation.trackers import Stop, Tracker
 
 __version__ = "0.1.0"
+
+# Imported on first use: they bring numba, scipy.optimize and matplotlib, a second of
+# `import beltsim` that listing scenes or building one does not need.
+_LAZY = {
+    "load_scene": "api", "paper_scene": "api", "run": "api", "scene_names": "api",
+    "shipped_scene": "api", "solve": "api",
+    "save_run": "io.results", "plot_fields": "plots.run", "plot_history": "plots.run",
+    "AnalyticSolution": "problem.analytic",
+    "Simulation": "simulation.controller",
+    "RunResult": "simulation.result", "RunStatus": "simulation.result",
+    "Stop": "simulation.trackers", "Tracker": "simulation.trackers",
+}
+
+
+_SUBPACKAGES = ("api", "beltdrive", "cli", "io", "physics", "plots", "problem",
+                "simulation", "solvers", "studies")
+
+
+def __getattr__(name):
+    import importlib
+
+    if name in _SUBPACKAGES:  # beltsim.solvers.settings... after a bare `import beltsim`
+        return importlib.import_module(f".{name}", __name__)
+    if name not in _LAZY:
+        raise AttributeError(f"module 'beltsim' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    globals()[name] = value  # once: later lookups skip this function
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
 
 __all__ = [
     "AnalyticSolution", "Beam", "BeltsimError", "Contact", "MissingInputError", "Motion",

@@ -353,7 +353,8 @@ def time_path(page: Page, quick: bool) -> None:
         "difference over t in [0.01, 0.5] s, relative to the steady value. The default "
         f"tolerance is 1e-4; the target is a path within {PATH_TOL:g}. The last column is "
         "the semi-discrete power balance over the run: the stored energy minus the "
-        "integral of driver - load - slip - damping - gyroscopic + transport power, "
+        "integral of the driver's power less the load, slip, damping and gyroscopic "
+        "powers plus the transport power, "
         "relative to the driver's work (`DriveResult.history`). Command: "
         f"`beltsim run {SCENE} --set numerics.time_tol=TOL --set numerics.t_end={t_end:g}`.")
     runs = {}
@@ -398,8 +399,8 @@ def time_path(page: Page, quick: bool) -> None:
 
 def build(page: Page, quick: bool) -> None:
     page.para(
-        f"The shipped `{SCENE}` scene (a flat belt on 80 and 160 mm pulleys, 150 rad/s, "
-        "50 N m, mu = 0.4) against the string's creep theory, the analytic steady state "
+        f"The shipped `{SCENE}` scene (a flat belt on pulleys of radius R = 80 / 160 mm, "
+        "150 rad/s, 50 N m, mu = 0.4) against the string's creep theory, the analytic steady state "
         "derived on the [theory page](../theory/drive.md). Every table is computed "
         "through beltsim's API; the commands give the same runs from the command line. "
         "Wall times exclude compilation.")

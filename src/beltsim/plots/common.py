@@ -3,8 +3,11 @@ made, and an atomic save.
 
 A drawing function takes an optional ``ax`` (one Axes, or a sequence of them for a
 figure of several panels) and returns the Figure it drew on. Without ``ax`` it makes a
-figure through pyplot, so that it shows as any matplotlib figure does (inline in
-Jupyter, in a window on a desktop backend). Figures written to files are made inside
+figure through pyplot, so that it shows as any matplotlib figure does (in a window on a
+desktop backend, in the gallery's scraper). Jupyter's inline backend is the exception:
+it shows every pyplot figure at the end of a cell, and the returned Figure shows again
+as the cell's value, so there the new figure is closed in pyplot at once and shows once,
+as the value (or with ``display(fig)``). Figures written to files are made inside
 :func:`offscreen` instead: plain :class:`matplotlib.figure.Figure` objects that no
 backend, window or pyplot list knows, so saving one neither needs a display nor
 changes the backend (the CLI draws this way).
@@ -57,7 +60,20 @@ def new_figure(figsize, **kwargs):
         from matplotlib.figure import Figure
         return Figure(figsize=figsize, **kwargs)
     import matplotlib.pyplot as plt
-    return plt.figure(figsize=figsize, **kwargs)
+    fig = plt.figure(figsize=figsize, **kwargs)
+    if _inline_backend():
+        # the inline backend would show it at the cell's end, and the returned Figure
+        # again as the cell's value; closed, it still draws and saves, and shows once
+        plt.close(fig)
+    return fig
+
+
+def _inline_backend() -> bool:
+    """Whether pyplot draws through Jupyter's inline backend (matplotlib-inline)."""
+    import matplotlib
+
+    backend = str(matplotlib.get_backend()).lower()
+    return backend == "inline" or backend.endswith("backend_inline")
 
 
 def panel_axes(ax, nrows: int, ncols: int = 1, figsize=(8.0, 6.0), **kwargs):

@@ -10,6 +10,8 @@ failure the state goes back to the last good check, so a failed run never holds 
 from __future__ import annotations
 
 import math
+import sys
+import threading
 import time
 
 import numpy as np
@@ -38,6 +40,11 @@ from .trackers import (
 )
 
 CHECKS_PER_TRANSIT = 4  # checks per transit time L / c
+#: A warm-up that takes longer than this (s) compiles the kernels; loading them from
+#: numba's cache takes a fraction of a second
+COMPILING_AFTER = 2.0
+COMPILE_NOTICE = ("beltsim: compiling the numba kernels, once per install (about 40 s on "
+                  "2 cores; later runs load them from the cache)")
 CHECKS_PER_PERIOD = 32  # at least, for a periodic drive (its extremes are read at checks)
 
 
@@ -157,9 +164,22 @@ class Simulation:
         return self.readout.solution(self.state, self.t, self.scheme.transient)
 
     # stepping ---------------------------------------------------------
-    def warm_up(self) -> float:
-        """Compile (or load from numba's cache) the kernels; returns the seconds it took."""
-        return self.scheme.warm_up(self.state)
+    def warm_up(self, notice: bool = False) -> float:
+        """Compile (or load from numba's cache) the kernels; returns the seconds it took.
+
+        With ``notice``, a warm-up still going after ``COMPILING_AFTER`` seconds says
+        on stderr that it compiles (the first run after an install waits that long).
+        """
+        timer = threading.Timer(COMPILING_AFTER, print, (COMPILE_NOTICE,),
+                                {"file": sys.stderr, "flush": True}) if notice else None
+        if timer is not None:
+            timer.daemon = True
+            timer.start()
+        try:
+            return self.scheme.warm_up(self.state)
+        finally:
+            if timer is not None:
+                timer.cancel()
 
     def advance(self, t_stop: float, max_steps: int = 10**9) -> None:
         """Step until t >= t_stop (transient schemes); raises NumericalError on failure."""
@@ -201,7 +221,8 @@ class Simulation:
         Parameters
         ----------
         progress : bool, optional
-            Show a progress bar (``tqdm.auto``: a widget in Jupyter, text elsewhere).
+            Show a progress bar (a widget in Jupyter with ipywidgets, text elsewhere),
+            and a notice on stderr while a first run compiles the kernels.
         raise_on_failure : bool, optional
             Raise :class:`~beltsim.errors.NumericalError` on a numerical failure; when
             False, return a result with status FAILED and the last good state.
@@ -230,7 +251,8 @@ class Simulation:
             returns something other than None or a :class:`Stop`.
         """
         trackers = _user_trackers(trackers)
-        compile_time = self.warm_up()
+        # the notice where someone watches: a progress bar asked for, or a terminal
+        compile_time = self.warm_up(notice=progress or sys.stderr.isatty())
         if not self.scheme.transient:
             return self._run_steady(raise_on_failure, compile_time, trackers)
         trackers = self.trackers(progress, handle_signals, callback, checkpoint, trackers)
@@ -376,7 +398,8 @@ def run(scene: Scene, progress: bool = False, raise_on_failure: bool = True,
     scene : Scene
         The scene; its ``numerics`` choose the scheme and the grid.
     progress : bool, optional
-        Show a progress bar (``tqdm.auto``: a widget in Jupyter, text elsewhere).
+        Show a progress bar (a widget in Jupyter with ipywidgets, text elsewhere),
+        and a notice on stderr while a first run compiles the kernels.
     raise_on_failure : bool, optional
         Raise on a numerical failure (default); when False, return a result with
         status FAILED holding the last good state.

@@ -397,23 +397,67 @@ class PowerBalanceTracker(Tracker):
         self.initial_energy = float(data["initial_energy"])
 
 
+def progress_bar(**kwargs):
+    """A tqdm progress bar: a widget in Jupyter with ipywidgets, text everywhere else.
+
+    ``tqdm.auto`` picks the widget in any Jupyter kernel and, where ipywidgets is
+    missing, warns "IProgress not found" before it falls back to text; this asks first
+    and goes straight to the text bar. In a kernel the text bar stays when closed
+    (``leave=True``), so that a saved notebook shows where the run ended, not a bar
+    frozen halfway or a cleared line.
+
+    Parameters
+    ----------
+    **kwargs
+        Passed to ``tqdm``.
+
+    Returns
+    -------
+    tqdm.std.tqdm
+        A ``tqdm.notebook.tqdm`` in a kernel with ipywidgets.
+    """
+    if _in_kernel():
+        if _has_widgets():
+            from tqdm.notebook import tqdm
+            return tqdm(**kwargs)
+        kwargs["leave"] = True
+    from tqdm.std import tqdm
+    return tqdm(**kwargs)
+
+
+def _in_kernel() -> bool:
+    """Whether this runs in a Jupyter kernel (as tqdm.autonotebook tells)."""
+    import sys
+
+    ipython = sys.modules.get("IPython")
+    try:
+        return ipython is not None and "IPKernelApp" in ipython.get_ipython().config
+    except Exception:  # no shell, or one without a config: not a kernel
+        return False
+
+
+def _has_widgets() -> bool:
+    from importlib.util import find_spec
+
+    return find_spec("ipywidgets") is not None
+
+
 class ProgressTracker(Tracker):
     """A progress bar of simulated time, with the rate and the total friction.
 
-    ``tqdm.auto`` draws it as a widget in Jupyter and as text on a terminal (or in
-    whatever takes stderr: the CLI asks for it only on a terminal).
+    A widget in Jupyter with ipywidgets (the ``notebook`` extra), else text
+    (:func:`progress_bar`): on a terminal, in a notebook without ipywidgets, or in
+    whatever takes stderr (the CLI asks for it only on a terminal).
     """
 
     def __init__(self):
         self.bar = None
 
     def initialize(self, sim):
-        from tqdm.auto import tqdm
-
-        self.bar = tqdm(total=sim.numerics.t_end, initial=sim.t, unit="s", unit_scale=True,
-                        desc="simulated", leave=False,
-                        bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s "
-                                   "[{elapsed}<{remaining}]{postfix}")
+        self.bar = progress_bar(total=sim.numerics.t_end, initial=sim.t, unit="s",
+                                unit_scale=True, desc="simulated", leave=False,
+                                bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s "
+                                           "[{elapsed}<{remaining}]{postfix}")
 
     def handle(self, sim):
         if self.bar is not None:

@@ -1,0 +1,74 @@
+"""The command line's text: summary tables, the run's summary lines, table cells and
+lists of grids (beltsim.cli prints them)."""
+
+from __future__ import annotations
+
+from .errors import UsageError
+
+
+def format_summary(summary: dict, title: str = "") -> str:
+    """A short human-readable table of a summary dict (a drive's: its figures)."""
+    if "tight_tension" in summary:
+        from .beltdrive.io import format_drive
+        return format_drive(summary, title)
+    rows = [("model", summary["model"]), ("inertia", str(summary["inertia"]).lower())]
+    for key, unit in (("total_friction", "N"), ("concentrated_force", "N"),
+                      ("distributed_friction", "N"), ("stick_friction", "N"),
+                      ("slip_friction", "N"), ("slip_start", "m"), ("slip_power", "W")):
+        value = summary.get(key)
+        if value is not None:
+            rows.append((key, f"{value:.6g} {unit}"))
+    width = max(len(k) for k, _ in rows)
+    lines = [title] if title else []
+    lines += [f"  {k:<{width}}  {v}" for k, v in rows]
+    return "\n".join(lines)
+
+
+def format_run(summary: dict) -> str:
+    """A run's lines: steps, simulated time, the solve's wall time beside the kernels'
+    compile or load time, the last period of a periodic drive, the errors."""
+    from .simulation.controller import COMPILING_AFTER
+
+    kernels = summary.get("compile_time") or 0.0
+    lines = [f"  converged       {str(summary['converged']).lower()} after "
+             f"{summary['steps']} steps, t = {summary['simulated_time']:.4g} s, "
+             f"wall {summary['wall_time']:.3g} s (+ {kernels:.2g} s "
+             f"{'compiling' if kernels > COMPILING_AFTER else 'loading'} the kernels)"]
+    if summary.get("status") not in (None, "converged"):
+        lines.append(f"  status          {summary['status']}")
+    per = summary.get("periodic")
+    if per:
+        for key, part in per.items():
+            if isinstance(part, dict):
+                lines.append(f"  last period     {key} min {part['min']:.6g}, mean "
+                             f"{part['mean']:.6g}, max {part['max']:.6g}")
+    err = summary.get("error")
+    if err:
+        parts = [f"{k} {v:.2e}" for k, v in err.items() if v is not None]
+        lines.append("  error vs exact  " + ", ".join(parts)
+                     + (" (slip_start in m)" if "slip_start" in err else ""))
+    return "\n".join(lines)
+
+
+def int_list(text, name):
+    """Comma-separated element counts (``--ladder``), each a grid beltsim accepts."""
+    from .problem.scene import MIN_ELEMENTS
+
+    try:
+        vals = [int(v) for v in text.split(",")]
+    except ValueError:
+        raise UsageError(f"{name}: expected comma-separated whole numbers, got {text!r}") from None
+    if any(v < MIN_ELEMENTS for v in vals):
+        raise UsageError(f"{name}: every grid needs at least {MIN_ELEMENTS} elements")
+    return vals
+
+
+def cell(v):
+    """A value right-aligned in a table column twelve characters wide."""
+    if isinstance(v, str):
+        return f"{v:>12s}"
+    if isinstance(v, bool):
+        return f"{str(v).lower():>12s}"
+    if isinstance(v, int):
+        return f"{v:>12d}"
+    return f"{v:>12.4g}"

@@ -1,0 +1,54 @@
+"""What a new user types first: `beltsim --version` and `beltsim scenes`."""
+
+import pytest
+
+import beltsim
+from beltsim import cli as cli_module
+
+
+@pytest.mark.cli
+def test_version_prints_the_package_version():
+    from helpers import cli
+
+    proc = cli("--version", timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == f"beltsim {beltsim.__version__}"
+
+
+@pytest.mark.cli
+def test_scenes_lists_every_shipped_scene_with_its_kind_and_title():
+    from helpers import cli
+
+    proc = cli("scenes", timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    lines = {line.split()[0]: line for line in proc.stdout.splitlines()}
+    assert tuple(sorted(lines)) == beltsim.scene_names()
+    for name in ("paper_slip", "drive_flat"):
+        assert beltsim.shipped_scene(name).title in lines[name]
+    assert "straight belt, stick and slip" in lines["paper_slip"]
+    assert "straight belt, perfect adhesion" in lines["paper_quasistatic"]
+    assert "closed drive" in lines["drive_flat"]
+
+
+@pytest.mark.unit
+def test_scenes_without_shipped_scenes_is_a_one_line_error(monkeypatch, capsys):
+    monkeypatch.setattr("beltsim.problem.scene.scene_names", lambda: ())
+    assert cli_module.main(["scenes"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no scenes ship" in err
+
+
+@pytest.mark.cli
+def test_analytic_writes_a_folder_of_its_own_scene_and_clears_what_it_did_not_write(tmp_path):
+    from helpers import cli
+
+    proc = cli("analytic", "paper_slip", cwd=tmp_path, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    own = tmp_path / "runs" / "out" / "analytic_paper_slip"
+    assert {p.name for p in own.iterdir()} == {"summary.json", "fields.csv"}
+    # a drive's analytic solution has no fields.csv: the straight belt's one goes
+    proc = cli("analytic", "drive_flat", "--set", "physics.model=string", "--out", own,
+               cwd=tmp_path, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert {p.name for p in own.iterdir()} == {"summary.json"}
+    assert "slip_arc_driver" in (own / "summary.json").read_text()
