@@ -7,10 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from beltsim.beltdrive import reference
-from beltsim.beltdrive.discrete import layout_of, loop_mesh, loop_params
 from beltsim.beltdrive.scene import DriveScene
-from beltsim.beltdrive.solver import make_system, newton, steady_rates
+from beltsim.physics.model import Loads
+from beltsim.problem.drive import Drive
+from beltsim.solvers import LoopDiscretisation
+from beltsim.solvers.newton import NewtonSettings, Workspace, newton
 from helpers import scene_path
 
 U, THETA = 1.0e-3, 2.0e-3  # amplitudes (m, rad): strains ~3e-3, as N0 / b1
@@ -59,44 +60,50 @@ def cell_average(fun, a, b, pieces):
 
 
 def manufactured_error(scene, elements):
+    """The discrete steady state of the one model's loop layout, with the manufactured
+    loads, against the manufactured fields and speeds (relative max errors)."""
     P = scene.params
     g = P.geometry
-    mesh = loop_mesh(g, elements)
-    lay = layout_of(mesh)
-    prm = loop_params(P, "tanh", V_REG)
-    S = make_system(mesh, prm, lay, P)
+    d = LoopDiscretisation(scene.with_overrides({
+        "numerics.elements": elements, "numerics.friction_law": "tanh",
+        "numerics.regularisation": V_REG}))
+    mesh, x = d.mesh, d.grid.x
     rim1 = P.omega1 * g.R1
     lam = g.loop_length
+    N = len(x)
     # each node's load is its control volume's average of the continuous source
-    lo = mesh.x - 0.5 * np.roll(mesh.he, 1)
-    hi = mesh.x + 0.5 * mesh.he
+    lo = x - 0.5 * np.roll(mesh.he, 1)
+    hi = x + 0.5 * mesh.he
     breaks = np.concatenate([g.bounds - lam, g.bounds, g.bounds + lam])
-    for j in range(lay.N):
-        S.q[2 * j] = cell_average(lambda z: source(np.mod(z, lam), P, rim1)[0], lo[j], hi[j],
-                                  breaks)
-        S.q[2 * j + 1] = cell_average(lambda z: source(np.mod(z, lam), P, rim1)[1], lo[j],
-                                      hi[j], breaks)
+    q = np.zeros((2, N))
+    for j in range(N):
+        for k in range(2):
+            q[k, j] = cell_average(lambda z, k=k: source(np.mod(z, lam), P, rim1)[k],
+                                   lo[j], hi[j], breaks)
+    zero = np.zeros((1, N))
+    loads = Loads(np.zeros(1), q[0][None, :], q[1][None, :], zero, zero)
     # the load torque that holds the driven pulley at omega2*: -R2 times the friction's
     # integral over the driven arc
     xg, wg = np.polynomial.legendre.leggauss(40)
     a, b = g.bounds[2], g.bounds[3]
     xs = 0.5 * (b - a) * xg + 0.5 * (a + b)
     M2 = -g.R2 * 0.5 * (b - a) * np.sum(wg * source(xs, P, rim1)[2])
-    u, _, _, th, _, _ = fields(mesh.x, lam)
-    y = np.zeros(lay.size)
-    y[0:2 * lay.N:2] = u
-    y[1:2 * lay.N:2] = th
-    y[lay.c], y[lay.omega2] = C_STAR, W2_STAR
+    u, du, _, th, dth, _ = fields(x, lam)
+    state = d.new_state()
+    state.u[:], state.theta[:] = u, th
+    state.g[:] = C_STAR, W2_STAR
     # the friction ratios' start: the law at the manufactured state (from lam = 0 the
     # Newton can find another of this nonlinear problem's solutions)
-    v = reference.slip_velocity(y, steady_rates(lay.N), rim1, mesh, prm)
-    y[2 * lay.N:2 * lay.N + lay.M] = np.tanh(v / V_REG)
-    y_star = y.copy()
-    newton(S, y, steady_rates(lay.N), rim1, M2, 1e-12, 40)
-    err_u = np.max(np.abs(lay.u(y) - lay.u(y_star))) / U
-    err_t = np.max(np.abs(lay.theta(y) - lay.theta(y_star))) / THETA
-    return (err_u, err_t, abs(y[lay.c] - C_STAR) / C_STAR,
-            abs(y[lay.omega2] - W2_STAR) / W2_STAR)
+    cn = mesh.cn
+    rim = np.where(mesh.seg[cn] == 0, rim1, W2_STAR * g.R2)
+    v = C_STAR * (1 + P.N0 / P.b1 + du[cn] + P.lever * dth[cn]) - rim
+    # inside (-1, 1): the law's inverse is singular on the bound
+    state.lam[cn] = np.clip(np.tanh(v / V_REG), -1.0 + 1e-12, 1.0 - 1e-12)
+    work = Workspace.allocate(N, False, True, 2)
+    assert newton(state, d.new_state(), 0.0, 0.0, mesh, d.model, Drive.constant(rim1, M2),
+                  loads, d.scales, NewtonSettings(1e-12, 40), work)
+    return (np.max(np.abs(state.u - u)) / U, np.max(np.abs(state.theta - th)) / THETA,
+            abs(state.g[0] - C_STAR) / C_STAR, abs(state.g[1] - W2_STAR) / W2_STAR)
 
 
 @pytest.mark.verification

@@ -208,6 +208,8 @@ def load_at(q, dq, k, w0, w1, v0, v1, j):
     """A tabulated load at node j, from the weights of :func:`hermite_weights` (0 for k < 0)."""
     if k < 0:
         return 0.0
+    if q.shape[0] == 1:  # one row: a constant load (there is no q[k + 1])
+        return q[0, j]
     return w0 * q[k, j] + w1 * q[k + 1, j] + v0 * dq[k, j] + v1 * dq[k + 1, j]
 
 

@@ -31,7 +31,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from ..problem.drive import friction_factor, mismatch
+from ..problem.drive import friction_factor, mismatch, value
 from .friction import ADHESION, AUGMENTATION, is_exact, law_numpy
 from .model import CENTRAL, POWER_TERMS, Mesh, ModelParams, State, hermite_weights
 
@@ -278,3 +278,68 @@ def power_terms(state: State, t, mesh: Mesh, p: ModelParams, drive, loads=None):
                              + p.rotary_inertia * td[sl] * _gyro_force(td, g)),
     }
     return np.array([terms[name] for name in POWER_TERMS])
+
+
+# -- a closed layout (a loop) ----------------------------------------------------------
+# The same equations on a periodic grid, with np.roll for the neighbours
+# (np.roll(v, 1)[j] = v[j - 1]) and the loop's global unknowns g = (c, omega_k ...): the
+# belt's c_t in the axial rows, the stiffnesses b1 - rho c^2 and a - I c^2, the pressure
+# bound mu (N0 + b1 u_x - rho c^2) / R and the creep c (1 + N0 / b1) in the slip velocity,
+# the gauge (the mean of u) and each free pulley's J omega_t + M(t) + R sum F.
+
+
+def loop_residual(u, th, lam, g, old, inv_dt, t, mesh: Mesh, p: ModelParams, drive,
+                  loads=None):
+    """(R, Rg): the rows (N, 2) and the global rows of a loop's backward-Euler residual,
+    as :func:`beltsim.physics.model.assemble` writes them; and F, the nodal friction.
+
+    A regularised law takes the ratio of the state's slip velocity (the primal form); an
+    exact law takes ``lam`` as it is (its ratios are unknowns).
+    """
+    rho, I, hh = p.mass, p.rotary_inertia, p.half_height
+    c = g[0]
+    B, A = p.b1 - rho * c * c, p.a - I * c * c
+    he, hb, sw = mesh.he, mesh.hb, mesh.sw
+    hl = np.roll(he, 1)
+    ud, td = (u - old.u) * inv_dt, (th - old.theta) * inv_dt
+    acc_u = (ud - old.ud) * inv_dt + p.damping * ud
+    acc_t = (td - old.td) * inv_dt + p.damping * td
+    if p.gyro == CENTRAL:
+        g0, gl, gu = 0.0, -c, c
+    else:
+        g0 = 2.0 * c * hb / hl
+        gl, gu = -g0, 0.0
+
+    def gyro(v):
+        return g0 * v + gl * np.roll(v, 1) + gu * np.roll(v, -1)
+
+    def lap(v):
+        return (np.roll(v, -1) - v) / he - (v - np.roll(v, 1)) / hl
+
+    def stencil(v):
+        return sw[:, 0] * np.roll(v, 2) + sw[:, 1] * np.roll(v, 1) + sw[:, 2] * v
+
+    on = mesh.seg >= 0
+    seg = np.maximum(mesh.seg, 0)
+    K = np.where(on, mesh.seg_speed[seg], -1)
+    R = np.where(on, mesh.seg_radius[seg], 1.0)
+    rim = np.where(K >= 1, g[np.maximum(K, 0)] * R, value(drive.speed, t))
+    ub, ubo = u + hh * th, old.u + hh * old.theta
+    vrel = (ub - ubo) * inv_dt + c * stencil(ub) - (rim - c * (1.0 + p.N0 / p.b1))
+    mu = mesh.seg_mu[seg]
+    fs = p.friction_scale * friction_factor(drive, t)
+    S = np.where(mu > 0.0, mu * (p.N0 + p.b1 * stencil(u) - rho * c * c) / R, fs)
+    ratio = lam if is_exact(p.law) else law_numpy(p.law, vrel / p.regularisation)[0]
+    F = np.where(on, -mesh.wf * S * ratio, 0.0)
+    qu, qt = loads_at(loads, t, len(u))
+    out = np.empty((len(u), 2))
+    out[:, 0] = (rho * hb * acc_u + rho * gyro(ud) - B * lap(u)
+                 + rho * hb * (c - old.g[0]) * inv_dt - hb * qu - F)
+    out[:, 1] = (I * hb * acc_t + I * gyro(td) - A * lap(th) + p.shear * hb * th
+                 - hb * qt - hh * F)
+    Rg = np.empty(len(g))
+    Rg[0] = np.sum(hb * u) / mesh.loop_length
+    for k in range(1, len(g)):
+        Rg[k] = (mesh.inertia[k] * (g[k] - old.g[k]) * inv_dt + value(drive.load, t)
+                 + np.sum(R[K == k] * F[K == k]))
+    return out, Rg, F

@@ -337,6 +337,9 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
             for k in range(ng):
                 g[k] += dg[k]
             update = max(step, dlam)
+            if not np.isfinite(dlam):  # a ratio started on the bound, where g^-1 is not
+                st.merit = merit(R, Rg, scales)
+                return False
             if (update_converged(update, previous, it, tol)
                     and not release_stuck_ratios(lam, w, mesh, p.law)):
                 friction_forces(lam, fnode, u, g, t, mesh, p, drive)
@@ -387,8 +390,13 @@ def update_size(dx, dg, scales):
         s = max(abs(dx[i, 0]) / scales.u, abs(dx[i, 1]) / scales.theta)
         if s > step:
             step = s
+        elif not s <= step:  # NaN: max and > pass it over
+            return np.inf
     for k in range(dg.shape[0]):
-        step = max(step, abs(dg[k]) / scales.glob[k])
+        s = abs(dg[k]) / scales.glob[k]
+        if not s <= step and not s > step:
+            return np.inf
+        step = max(step, s)
     return step
 
 
