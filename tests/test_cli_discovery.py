@@ -32,7 +32,7 @@ def test_scenes_lists_every_shipped_scene_with_its_kind_and_title():
 
 @pytest.mark.unit
 def test_scenes_without_shipped_scenes_is_a_one_line_error(monkeypatch, capsys):
-    monkeypatch.setattr("beltsim.problem.scene.scene_names", lambda: ())
+    monkeypatch.setattr("beltsim.problem.shipped.scenes_dir", lambda: None)
     assert cli_module.main(["scenes"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "no scenes ship" in err

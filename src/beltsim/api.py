@@ -15,9 +15,10 @@ a scene's tables::
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from .beltdrive.scene import DriveScene, is_drive
 from .errors import SceneError, UsageError
 from .problem.scene import Scene
 from .problem.shipped import paper_scene_name, scene_names, shipped_text
@@ -26,16 +27,24 @@ from .problem.tomlio import parse_toml, read_scene_file
 __all__ = ["is_drive_scene", "load_scene", "paper_scene", "run", "scene_from_tables",
            "scene_names", "shipped_scene", "solve"]
 
-#: Either kind of scene.
-AnyScene = Scene | DriveScene
+if TYPE_CHECKING:
+    from .beltdrive.scene import DriveScene
+
+
+def is_drive_data(data) -> bool:
+    """Whether scene tables (a dict) describe a closed drive: they have a ``[drive]`` table."""
+    return isinstance(data, dict) and "drive" in data
 
 
 def is_drive_scene(scene) -> bool:
     """Whether a scene is a closed drive (a :class:`~beltsim.beltdrive.scene.DriveScene`)."""
-    return isinstance(scene, DriveScene)
+    # A DriveScene exists only once its module is loaded; importing it for a straight
+    # belt would cost numpy and scipy.
+    drive = sys.modules.get("beltsim.beltdrive.scene")
+    return drive is not None and isinstance(scene, drive.DriveScene)
 
 
-def scene_from_tables(data: dict, source: str | None = None) -> AnyScene:
+def scene_from_tables(data: dict, source: str | None = None) -> Scene | DriveScene:
     """A scene from its tables: a closed drive where they have a ``[drive]`` section, a
     straight belt otherwise.
 
@@ -55,7 +64,9 @@ def scene_from_tables(data: dict, source: str | None = None) -> AnyScene:
     SceneError
         On the first broken rule, naming the key and the rule.
     """
-    if is_drive(data):
+    if is_drive_data(data):
+        from .beltdrive.scene import DriveScene
+
         return DriveScene(data, source=source)
     return Scene(data, source=source)
 
@@ -65,7 +76,7 @@ def _looks_like_name(text: str) -> bool:
     return "/" not in text and "\\" not in text and not text.endswith(".toml")
 
 
-def load_scene(scene, overrides=()) -> AnyScene:
+def load_scene(scene, overrides=()) -> Scene | DriveScene:
     """A scene of either kind, with overrides applied.
 
     Parameters
@@ -95,7 +106,7 @@ def load_scene(scene, overrides=()) -> AnyScene:
     >>> scene = beltsim.load_scene("paper_slip", ["contact.max_friction=2e5"])  # doctest: +SKIP
     >>> drive = beltsim.load_scene("runs/drive_flat.toml")                     # doctest: +SKIP
     """
-    if isinstance(scene, (Scene, DriveScene)):
+    if isinstance(scene, Scene) or is_drive_scene(scene):
         loaded = scene
     elif isinstance(scene, dict):
         loaded = scene_from_tables(scene)
@@ -111,7 +122,7 @@ def load_scene(scene, overrides=()) -> AnyScene:
     return loaded.with_overrides(overrides) if overrides else loaded
 
 
-def shipped_scene(name: str, overrides=()) -> AnyScene:
+def shipped_scene(name: str, overrides=()) -> Scene | DriveScene:
     """A scene shipped with beltsim, by name: its file's stem (see :func:`scene_names`).
 
     Parameters

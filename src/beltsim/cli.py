@@ -35,10 +35,8 @@ def _scene(args):
 
 
 def _is_drive(scene) -> bool:
-    # a drive scene exists only once its module is loaded; importing it costs a straight
-    # belt's command a third of a second
-    drive = sys.modules.get("beltsim.beltdrive.scene")
-    return drive is not None and isinstance(scene, drive.DriveScene)
+    from .api import is_drive_scene
+    return is_drive_scene(scene)
 
 
 def _straight_only(args, scene):
@@ -377,11 +375,11 @@ def cmd_animate(args):
     if args.from_dir:
         if args.scene or args.overrides:
             raise UsageError("--from DIR animates a stored run: give no SCENE or --set")
-        from .beltdrive.scene import is_drive
+        from .api import is_drive_data
 
         src = Path(args.from_dir)
         out = prepare_outdir(args.out or src)
-        if _stored_drive(src, is_drive):
+        if _stored_drive(src, is_drive_data):
             return _drive_animate(args, out, src)
     else:
         if not args.scene:
@@ -424,8 +422,8 @@ def cmd_plot(args):
 
 
 def cmd_scenes(args):
+    from .api import scene_names, shipped_scene
     from .errors import MissingInputError
-    from .problem.scene import scene_names, shipped_scene
 
     names = scene_names()
     if not names:

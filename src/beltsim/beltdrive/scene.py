@@ -41,7 +41,7 @@ from .geometry import Geometry, GeometryError
 from .params import DriveParams, params_of
 
 __all__ = ["MIN_SEGMENT_ELEMENTS", "OPTIONAL_SECTIONS", "REQUIRED", "SCHEMA", "DriveParams",
-           "DriveScene", "is_drive", "max_rim_speed", "set_key", "validate"]
+           "DriveScene", "max_rim_speed", "set_key", "validate"]
 
 #: The fewest elements on each of the loop's four segments.
 MIN_SEGMENT_ELEMENTS = 4
@@ -111,11 +111,6 @@ REQUIRED = {"belt": ("height", "width", "youngs_modulus", "poisson_ratio", "shea
             "contact": ("friction",),
             "physics": ("inertia",)}
 OPTIONAL_SECTIONS = ("stiffness", "numerics")
-
-
-def is_drive(data) -> bool:
-    """Whether scene data (a dict) describes a closed drive: it has a [drive] section."""
-    return isinstance(data, dict) and "drive" in data
 
 
 def validate(data: dict) -> dict:
