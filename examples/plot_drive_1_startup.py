@@ -19,12 +19,11 @@ command line, with the pictures::
 import matplotlib.pyplot as plt
 
 import beltsim
-from beltsim import beltdrive
 from beltsim.beltdrive import plots
 
 scene = beltsim.load_scene("drive_flat")
-result = beltdrive.simulate(scene)
-s = result.summary
+result = beltsim.run(scene)
+s = result.summary()
 print(f"{result.status.value} at t = {result.history['t'][-1]:.3f} s after "
       f"{result.statistics['steps']} steps, {result.wall_time:.2f} s wall")
 print(f"tight / slack tension {s['tight_tension']:.1f} / {s['slack_tension']:.1f} N, "
@@ -54,7 +53,7 @@ plt.show()
 # the analytic steady state (the string's creep theory; the beam's friction has a short
 # boundary layer at the slip fronts).
 
-plots.plot_loop_fields(result.x, result.fields, g, analytic=result.analytic)
+plots.plot_loop_fields(result.x, result.fields, g, analytic=result.reference)
 plt.show()
 
 # %%
@@ -64,5 +63,5 @@ plt.show()
 # their ratio says little.)
 
 plots.plot_drive_history(result.history["t"], result.history,
-                         steady=result.analytic.summary())
+                         steady=result.reference.summary())
 plt.show()

@@ -23,7 +23,7 @@ from beltsim.beltdrive import plots
 
 scene = beltsim.load_scene("drive_load_step")
 print(scene.drive["load_torque"])
-result = beltdrive.simulate(scene)
+result = beltsim.run(scene)
 h = result.history
 print(f"{result.status.value} at t = {h['t'][-1]:.3f} s after "
       f"{result.statistics['steps']} steps, {result.wall_time:.2f} s wall")
@@ -36,7 +36,7 @@ print(f"{'':18s}{'run, t = 1 s':>14s}{'30 N m':>12s}{'run, end':>12s}{'60 N m':>
 for key in ("tight_tension", "slack_tension", "speed_ratio", "slip_arc_driver",
             "driver_torque", "slip_power"):
     print(f"{key:18s}{h[key][i]:14.6g}{before.summary()[key]:12.6g}"
-          f"{result.summary[key]:12.6g}{after.summary()[key]:12.6g}")
+          f"{result.summary()[key]:12.6g}{after.summary()[key]:12.6g}")
 
 # %%
 # The history against the analytic states of both loads: dashed before the step (30 N

@@ -4,11 +4,12 @@ A closed drive's characteristic curve
 
 How much speed and power does the drive lose as the load grows, and where does the belt
 slip through? Below the drive's capacity (the load at which the slip arcs cover the
-smaller wrap) every load has a steady state, which :func:`~beltsim.beltdrive.run.solve_steady`
-finds by Newton's method in milliseconds; beyond it there is none, and a run from rest
-ends in gross slip: the belt slides over the driver's whole wrap and the driven pulley
-falls back. The analytic curves are the string's creep theory
-(:func:`~beltsim.beltdrive.analytic.solve_string`). One point from the command line::
+smaller wrap) every load has a steady state, which the steady scheme
+(``numerics.integrator = "steady"``) finds by Newton's method in milliseconds; beyond it
+there is none, and a run from rest ends in gross slip: the belt slides over the driver's
+whole wrap and the driven pulley falls back. The analytic curves are the string's creep
+theory (:func:`~beltsim.beltdrive.analytic.solve_string`). One point from the command
+line::
 
     beltsim run drive_flat --set drive.load_torque=80 --set numerics.integrator=steady
 
@@ -32,9 +33,10 @@ print(f"capacity at {P.omega1:g} rad/s: {cap:.2f} N m")
 loads = np.linspace(5.0, 0.98 * cap, 14)
 loss, eff = [], []
 for m2 in loads:
-    r = beltdrive.solve_steady(scene.with_overrides([("drive.load_torque", float(m2))]))
-    loss.append(1.0 - r.summary["speed_ratio"])
-    eff.append(r.summary["efficiency"])
+    r = beltsim.run(scene, overrides={"drive.load_torque": float(m2),
+                                      "numerics.integrator": "steady"})
+    loss.append(1.0 - r.summary()["speed_ratio"])
+    eff.append(r.summary()["efficiency"])
 
 
 def exact(m2, key):
@@ -47,7 +49,7 @@ analytic = {"speed_loss": lambda m2: 1.0 - exact(m2, "speed_ratio"),
 # a run whose load rises slowly past the capacity, once the drive is up to speed
 ramp = scene.with_overrides([("drive.load_torque",
                               [[0.0, 0.0], [0.4, 40.0], [3.0, 1.1 * cap]])])
-slow = beltdrive.simulate(ramp)
+slow = beltsim.run(ramp, raise_on_failure=False)
 print(f"load ramped to {1.1 * cap:.1f} N m: {slow.status.value}, {slow.reason}")
 
 # %%
@@ -79,7 +81,8 @@ plt.show()
 
 fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, layout="constrained")
 for factor, color in ((0.95, "tab:blue"), (1.05, "tab:orange"), (1.2, "tab:red")):
-    run = beltdrive.simulate(scene.with_overrides([("drive.load_torque", factor * cap)]))
+    run = beltsim.run(scene, raise_on_failure=False,
+                      overrides={"drive.load_torque": factor * cap})
     print(f"{factor:.2f} x capacity: {run.status.value}"
           + (f" ({run.reason})" if run.reason else ""))
     rh = run.history

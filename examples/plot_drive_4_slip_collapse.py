@@ -39,13 +39,14 @@ print(f"gross slip below mu = {mu_min:.4f} at {P.M2:g} N m")
 mus = np.geomspace(1.05 * mu_min, 20.0, 11)
 driver, driven, tight = [], [], []
 for mu in mus:
-    r = beltdrive.solve_steady(with_mu(mu))
-    driver.append(r.summary["slip_arc_driver"])
-    driven.append(r.summary["slip_arc_driven"])
-    tight.append(r.summary["tight_tension"])
+    r = beltsim.run(with_mu(mu), overrides={"numerics.integrator": "steady"})
+    s = r.summary()
+    driver.append(s["slip_arc_driver"])
+    driven.append(s["slip_arc_driven"])
+    tight.append(s["tight_tension"])
     print(f"mu = {mu:6.3f}: slip arcs {driver[-1]:.4f}, {driven[-1]:.4f} rad "
-          f"(analytic {r.analytic.phi_s:.4f}), tight tension "
-          f"{r.summary['tight_tension']:.2f} N")
+          f"(analytic {r.reference.phi_s:.4f}), tight tension "
+          f"{s['tight_tension']:.2f} N")
 
 
 def phi_s(mu):

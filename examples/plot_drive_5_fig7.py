@@ -20,7 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import beltsim
-from beltsim.beltdrive import DriveScene, solve_steady
+from beltsim.beltdrive import DriveScene
 from beltsim.beltdrive.beam import solve_beam
 
 scene = beltsim.load_scene("drive_flat")
@@ -50,7 +50,7 @@ for ax, (lo, hi), name in zip(axes, windows, ("driver arc", "driven arc")):
     ax.set_xlabel("loop coordinate x [m]")
 axes[0].set_ylabel("rotation theta [mrad]")
 
-discrete = solve_steady(scene)
+discrete = beltsim.run(scene, overrides={"numerics.integrator": "steady"})
 for ax, (lo, hi) in zip(axes, windows):
     on = (discrete.x >= lo) & (discrete.x <= hi)
     ax.plot(discrete.x[on][::2], 1e3 * discrete.fields["theta"][on][::2], "o", ms=2.5,

@@ -10,7 +10,7 @@
 ``drive-keys SECTION``
     The same for a closed drive's scene, from :data:`beltsim.beltdrive.scene.SCHEMA`; a
     default may quote the constants of :mod:`beltsim.beltdrive.scene`,
-    :mod:`beltsim.beltdrive.discrete` and :mod:`beltsim.beltdrive.run`.
+    :mod:`beltsim.physics.layout` and :mod:`beltsim.solvers.settings`.
 
 ``beltsim-cli COMMAND``
     Usage, description and options of one subcommand of ``beltsim``, from
@@ -33,10 +33,9 @@ from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 
 import beltsim
-from beltsim.beltdrive import discrete as drive_discrete
-from beltsim.beltdrive import run as drive_run
 from beltsim.beltdrive import scene as drive_scene
 from beltsim.cli import build_parser
+from beltsim.physics import layout as loop_layout
 from beltsim.problem import scene as scene_module
 from beltsim.solvers import settings
 
@@ -48,12 +47,13 @@ def _cell(text: str) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
 
-def rule_text(rule, key="", registry=True) -> str:
-    """A rule of the schema in words (``key``: the section.key it belongs to; ``registry``:
-    the straight belt's schema, whose integrator the scheme registry checks)."""
-    if registry and key == "numerics.integrator":  # the registry checks it: its names
+def rule_text(rule, key="", closed=False) -> str:
+    """A rule of the schema in words (``key``: the section.key it belongs to; ``closed``:
+    a closed drive's schema, whose integrators are the registry's closed-layout ones)."""
+    if key == "numerics.integrator":  # the registry checks it: its names
         from beltsim import solvers
-        return ", ".join(f'`"{n}"`' for n in solvers.names())
+        return ", ".join(f'`"{n}"`' for n in solvers.names()
+                         if not closed or solvers.registry.get(n).closed)
     if rule.kind == "profile":
         return "number > 0, table or sine ([drive profiles](drive-profiles.md))"
     if rule.kind == "load":
@@ -109,7 +109,7 @@ class SceneKeys(SphinxDirective):
     schema_module = scene_module
     constant_modules = (settings,)
     kind = "sections"  # what _shown records
-    registry = True  # the integrator is a name of the scheme registry
+    closed = False  # the layout whose schemes the integrator's rule lists
 
     def run(self):
         section = self.arguments[0]
@@ -143,7 +143,7 @@ class SceneKeys(SphinxDirective):
             default, meaning = given[key]
             default = _substitute(default, consts, self, f"{section}.{key}")
             meaning = _substitute(meaning, consts, self, f"{section}.{key}")
-            rule = _cell(rule_text(rules[key], f"{section}.{key}", self.registry))
+            rule = _cell(rule_text(rules[key], f"{section}.{key}", self.closed))
             lines.append(f"| `{key}` | {rule} | {default} | "
                          f"{meaning} |")
         for module in (self.schema_module, *self.constant_modules):
@@ -159,9 +159,9 @@ class DriveKeys(SceneKeys):
     """The table of one closed-drive scene section's keys."""
 
     schema_module = drive_scene
-    constant_modules = (drive_scene, drive_discrete, drive_run)
+    constant_modules = (drive_scene, loop_layout, settings)
     kind = "drive sections"
-    registry = False  # the drive's integrators are the schema's own choices
+    closed = True
 
 
 def _subparsers(parser) -> dict:

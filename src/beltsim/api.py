@@ -4,7 +4,7 @@ A straight belt (:class:`~beltsim.problem.scene.Scene`) and a closed drive
 (:class:`~beltsim.beltdrive.scene.DriveScene`) are read, run and solved by different
 parts of the package; this module, above both, is the one place that tells them apart.
 Every function here takes either kind, as a scene, a shipped scene's name (its file's
-stem, ``"paper_slip"``, ``"drive_flat"``; :func:`scene_names`), a scene file's path or
+stem, ``"paper_slip"``, ``"drive_flat"``; :func:`beltsim.scene_names`), a scene file's path or
 a scene's tables::
 
     import beltsim
@@ -82,7 +82,7 @@ def load_scene(scene, overrides=()) -> Scene | DriveScene:
     Parameters
     ----------
     scene : Scene, DriveScene, str, Path or dict
-        A scene; a shipped scene's name, its file's stem (:func:`scene_names`); a scene
+        A scene; a shipped scene's name, its file's stem (:func:`beltsim.scene_names`); a scene
         file's path; or a scene's tables. A name that is not an existing file
         (``"paper_slip"``) is looked up among the shipped scenes.
     overrides : dict, str or iterable of str or (str, value), optional
@@ -123,7 +123,7 @@ def load_scene(scene, overrides=()) -> Scene | DriveScene:
 
 
 def shipped_scene(name: str, overrides=()) -> Scene | DriveScene:
-    """A scene shipped with beltsim, by name: its file's stem (see :func:`scene_names`).
+    """A scene shipped with beltsim, by name: its file's stem (see :func:`beltsim.scene_names`).
 
     Parameters
     ----------

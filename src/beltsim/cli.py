@@ -340,12 +340,14 @@ def cmd_paper(args):
     return 0
 
 
-def _stored_drive(run_dir, is_drive) -> bool:
+def _stored_drive(run_dir) -> bool:
     """Whether a run directory holds a closed drive's run (its scene.toml has [drive])."""
     import tomllib
 
+    from .api import is_drive_data
+
     try:
-        return is_drive(tomllib.loads((run_dir / "scene.toml").read_text(encoding="utf-8")))
+        return is_drive_data(tomllib.loads((run_dir / "scene.toml").read_text(encoding="utf-8")))
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
         return False  # the straight belt's reader says what is wrong
 
@@ -375,11 +377,9 @@ def cmd_animate(args):
     if args.from_dir:
         if args.scene or args.overrides:
             raise UsageError("--from DIR animates a stored run: give no SCENE or --set")
-        from .api import is_drive_data
-
         src = Path(args.from_dir)
         out = prepare_outdir(args.out or src)
-        if _stored_drive(src, is_drive_data):
+        if _stored_drive(src):
             return _drive_animate(args, out, src)
     else:
         if not args.scene:
@@ -412,10 +412,9 @@ def cmd_plot(args):
     from pathlib import Path
 
     from .beltdrive.io import plot_drive_run
-    from .beltdrive.scene import is_drive
     from .plots.run import plot_run
 
-    paths = (plot_drive_run if _stored_drive(Path(args.dir), is_drive) else plot_run)(
+    paths = (plot_drive_run if _stored_drive(Path(args.dir)) else plot_run)(
         args.dir, args.out)
     print("wrote " + ", ".join(str(p) for p in paths))
     return 0

@@ -7,17 +7,13 @@ import time
 
 import numpy as np
 
+import beltsim
 from beltsim.api import shipped_scene
-from beltsim.beltdrive import (
-    DriveScene,
-    DriveStatus,
-    GrossSlipError,
-    capacity,
-    simulate,
-    solve_steady,
-    solve_string,
-)
-from beltsim.beltdrive.discrete import DEFAULT_ELEMENTS, loop_mesh
+from beltsim.beltdrive import DriveScene, GrossSlipError, capacity, solve_string
+from beltsim.physics.layout import LoopGrid
+from beltsim.simulation.result import RunStatus
+from beltsim.solvers.settings import LOOP_ELEMENTS as DEFAULT_ELEMENTS
+from beltsim.solvers.settings import TIME_TOLS as SCHEME_TIME_TOLS
 
 from .kit import Page, fmt, num
 
@@ -65,7 +61,20 @@ def _string(overrides=()) -> DriveScene:
 
 def _h(scene: DriveScene, elements: int) -> float:
     """The grid's largest element (m)."""
-    return float(loop_mesh(scene.params.geometry, elements).he.max())
+    return float(LoopGrid.build(scene.params.geometry.lengths, elements).he.max())
+
+
+def solve_steady(scene: DriveScene, elements: int | None = None):
+    """The steady scheme's state of a drive (``numerics.integrator = "steady"``)."""
+    sets = [("numerics.integrator", "steady")]
+    if elements is not None:
+        sets.append(("numerics.elements", elements))
+    return beltsim.run(scene.with_overrides(sets))
+
+
+def simulate(scene: DriveScene):
+    """A run from rest by the scene's scheme, its failures returned as results."""
+    return beltsim.run(scene, raise_on_failure=False)
 
 
 def _balance(summary: dict) -> tuple[float, float]:
@@ -81,7 +90,7 @@ def ladder(page: Page, quick: bool, beam: bool = False) -> list[dict]:
     if beam:
         page.para(
             "The same ladder for the beam model (the shipped scene as it is) against the "
-            "beam's exact steady state (`beltsim.beltdrive.beam.solve_beam`: piecewise "
+            "beam's exact steady state (`beltsim.beltdrive.beam.exact_state`: piecewise "
             "exponentials, the slip arcs' starts as unknowns), on a ladder reaching 128 "
             "times finer. On coarse grids the slip arcs' errors scatter: the stick zones' "
             "boundary layer next to the slip front, sqrt((A + B h^2 / 4) / b2) = 4.2 mm for "
@@ -106,7 +115,7 @@ def ladder(page: Page, quick: bool, beam: bool = False) -> list[dict]:
     for n in rungs:
         r = solve_steady(scene, n)
         rows.append({"elements": n, "h": _h(scene, n), "result": r, "errors": r.errors(),
-                     "balance": _balance(r.summary)})
+                     "balance": _balance(r.summary())})
     body = [[str(r["elements"]), f"{r['h'] * 1e3:.4g}",
              str(r["result"].statistics["newton_iterations"]),
              fmt(r["result"].wall_time * 1e3, ".3g"),
@@ -205,29 +214,29 @@ def startup(page: Page, quick: bool) -> None:
         "the driver's speed and the load ramp up smoothly over two transits of the loop, "
         "and the run stops when the drive is steady (`numerics.steady_tol`). Errors of "
         "the end state against the analytic steady state the run compares with "
-        "(`DriveResult.analytic`: the string's for the string model; for the beam, the "
+        "(`RunResult.reference`: the string's for the string model; for the beam, the "
         "beam's exact solution where beltsim has it, else the string's, which the beam "
         "differs from by its shear and bending). The target: a default start-up in "
-        f"at most {STARTUP_WALL:g} s wall (for the default, implicit scheme; the explicit "
-        "scheme steps at the axial waves' limit and, without numerical damping, settles "
-        f"later). Commands: `beltsim run {SCENE} --set physics.model=string`, `beltsim run "
-        f"{SCENE}` (the beam) and `beltsim run {SCENE} --set numerics.integrator=explicit`"
+        f"at most {STARTUP_WALL:g} s wall for the default scheme (esdirk3, which resolves "
+        "the drive's rotational mode at about 88 Hz and its decay; BDF2, `implicit`, "
+        "damps it numerically and settles in fewer steps). Commands: `beltsim run "
+        f"{SCENE} --set physics.model=string`, `beltsim run {SCENE}` (the beam) and "
+        f"`beltsim run {SCENE} --set numerics.integrator=implicit`"
         + (f", with `--set numerics.elements={QUICK_ELEMENTS}`" if quick else "") + ".")
     keys = ("tight_tension", "slack_tension", "speed_loss", "slip_arc_driver",
             "slip_arc_driven", "slip_power")
     body = []
-    explicit = ("numerics.integrator", "explicit")
+    bdf2 = ("numerics.integrator", "implicit")
     for label, scene in (("string", _string(grid)), ("beam", shipped_scene(SCENE, grid)),
-                         ("beam, explicit", shipped_scene(SCENE, [*grid, explicit]))):
+                         ("beam, BDF2", shipped_scene(SCENE, [*grid, bdf2]))):
         r = simulate(scene)
         if r.converged:
             status = "converged"
         else:
             status = page.fail(f"start-up, {label}: {r.status.value} ({r.reason})")
         e = r.errors()
-        target = "met" if r.wall_time <= STARTUP_WALL else (
-            "not met on this machine" if "explicit" not in label else "no target")
-        body.append([label, type(r.analytic).__name__, status,
+        target = "met" if r.wall_time <= STARTUP_WALL else "not met on this machine"
+        body.append([label, type(r.reference).__name__, status,
                      fmt(float(r.history["t"][-1]), ".4g"), str(r.statistics["steps"]),
                      str(r.statistics.get("newton_iterations", "")),
                      str(r.statistics.get("rejected_steps", "")),
@@ -260,15 +269,15 @@ def threshold(page: Page, quick: bool) -> None:
         load = frac * cap
         s = scene.with_overrides([("drive.load_torque", load)])
         r = simulate(s)
-        expect = DriveStatus.CONVERGED if frac < 1 else DriveStatus.GROSS_SLIP
+        expect = RunStatus.CONVERGED if frac < 1 else RunStatus.GROSS_SLIP
         status = r.status.value if r.status is expect else page.fail(
             f"threshold, {frac:g} x capacity: {r.status.value}, expected {expect.value}")
         try:
             exact = solve_string(s.params)
-            arc = f"{r.summary['slip_arc_driver']:.4f} / {exact.phi_s:.4f}"
+            arc = f"{r.summary()['slip_arc_driver']:.4f} / {exact.phi_s:.4f}"
             steady = "solved"
         except GrossSlipError as exc:
-            arc = f"{r.summary['slip_arc_driver']:.4f} / (none)"
+            arc = f"{r.summary()['slip_arc_driver']:.4f} / (none)"
             steady = "refused: " + str(exc)
         if frac > 1:
             try:
@@ -291,40 +300,45 @@ def balance(page: Page, rows: list[dict], quick: bool) -> None:
         "- load power - slip power of the steady states above falls with the grid. The "
         "driver's torque is exact and the speeds' errors are tiny, so the residual is the "
         "error of the slip power, the discrete friction's work, and falls at its order.")
-    body = [[str(r["elements"]), f"{r['result'].summary['driver_power']:.6g}",
-             f"{r['result'].summary['load_power']:.6g}",
-             f"{r['result'].summary['slip_power']:.6g}", f"{r['balance'][0]:.3e}",
+    body = [[str(r["elements"]), f"{r['result'].summary()['driver_power']:.6g}",
+             f"{r['result'].summary()['load_power']:.6g}",
+             f"{r['result'].summary()['slip_power']:.6g}", f"{r['balance'][0]:.3e}",
              f"{r['balance'][1]:.3e}",
-             f"{r['balance'][0] / r['result'].summary['slip_power']:.3e}"] for r in rows]
+             f"{r['balance'][0] / r['result'].summary()['slip_power']:.3e}"] for r in rows]
     page.table(["elements", "driver power [W]", "load power [W]", "slip power [W]",
                 "residual [W]", "residual / driver power", "residual / slip power"], body)
     data = _string().to_dict()
     data["contact"] = {"friction": "stick"}
     stick = DriveScene(data)
     r = solve_steady(stick, QUICK_ELEMENTS if quick else None)
-    lost = r.summary["driver_power"] - r.summary["load_power"]
-    exact = r.analytic
+    sm = r.summary()
+    lost = sm["driver_power"] - sm["load_power"]
+    exact = r.reference
     page.para(
         "Perfect adhesion (`contact.friction = \"stick\"`, the string model, "
         f"{r.numerics.elements} elements): every node sticks, so the nodal slip power is "
-        f"{r.summary['slip_power']:.3g} W, yet the driver supplies "
-        f"{r.summary['driver_power']:.6g} W and the load takes "
-        f"{r.summary['load_power']:.6g} W. The difference, {lost:.6g} W, is the analytic "
+        f"{sm['slip_power']:.3g} W, yet the driver supplies "
+        f"{sm['driver_power']:.6g} W and the load takes "
+        f"{sm['load_power']:.6g} W. The difference, {lost:.6g} W, is the analytic "
         f"creep loss kappa c dT^2 / b1 = {exact.slip_power:.6g} W (relative difference "
         f"{(lost - exact.slip_power) / exact.slip_power:.2e}): it is dissipated by the "
         "concentrated friction forces at the arcs' exits, where the belt's speed jumps, "
         "and no nodal slip power records it.")
 
 
+#: the default scheme's time tolerance (esdirk3)
+DEFAULT_TIME_TOL = SCHEME_TIME_TOLS["esdirk3"]
 #: time tolerances of the path study and its reference (numerics.time_tol)
-TIME_TOLS = {False: (1e-3, 1e-4, 1e-5), True: (1e-3, 1e-4)}
-TIME_REFERENCE = {False: 1e-6, True: 1e-5}
+TIME_TOLS = {False: (1e-3, 1e-4, DEFAULT_TIME_TOL), True: (1e-3, DEFAULT_TIME_TOL)}
+TIME_REFERENCE = {False: 1e-6, True: 2e-6}
 PATH_KEYS = ("tight_tension", "slack_tension", "belt_speed", "driven_speed")
 #: the paths held to PATH_TOL at the default tolerance (the tensions are reported: see the
 #: page's note on the spans' oscillation)
 PATH_HELD = ("belt_speed", "driven_speed")
 #: the path's target: within this of a run refined in time (relative to the steady value)
 PATH_TOL = 1e-3
+#: the checks' interval of the path study (s): the history then resolves the 88 Hz ringing
+CHECK_INTERVAL = 2e-4
 
 
 def _energy_mismatch(r) -> float:
@@ -348,19 +362,23 @@ def time_path(page: Page, quick: bool) -> None:
     ref_tol = TIME_REFERENCE[quick]
     page.para(
         "The start-up's path in time: the beam model of the shipped scene from rest to "
-        f"t = {t_end:g} s with the adaptive BDF2 steps at several local-error tolerances "
-        f"`numerics.time_tol`, against a run at {ref_tol:g}. Path error: the largest "
-        "difference over t in [0.01, 0.5] s, relative to the steady value. The default "
-        f"tolerance is 1e-4; the target is a path within {PATH_TOL:g}. The last column is "
+        f"t = {t_end:g} s with the default scheme's adaptive steps (esdirk3) at several "
+        f"local-error tolerances `numerics.time_tol`, against a run at {ref_tol:g}. Path "
+        f"error: the largest difference over t in [0.01, {t_end:g}] s, relative to the "
+        f"steady value. The default tolerance is {DEFAULT_TIME_TOL:g}; the target is a "
+        f"path within {PATH_TOL:g}. The last column is "
         "the semi-discrete power balance over the run: the stored energy minus the "
         "integral of the driver's power less the load, slip, damping and gyroscopic "
         "powers plus the transport power, "
-        "relative to the driver's work (`DriveResult.history`). Command: "
+        "relative to the driver's work, by the trapezoidal rule over the history's checks "
+        f"(`RunResult.history`, a check every {CHECK_INTERVAL * 1e3:g} ms, the snapshot "
+        "interval, which resolves the drive's rotational oscillation). Command: "
         f"`beltsim run {SCENE} --set numerics.time_tol=TOL --set numerics.t_end={t_end:g}`.")
     runs = {}
     for tol in (*TIME_TOLS[quick], ref_tol):
         start = time.perf_counter()
-        r = simulate(shipped_scene(SCENE, [*common, ("numerics.time_tol", tol)]))
+        r = beltsim.run(shipped_scene(SCENE, [*common, ("numerics.time_tol", tol)]),
+                        raise_on_failure=False, snapshot_interval=CHECK_INTERVAL)
         runs[tol] = (r, time.perf_counter() - start)
     ref = runs[ref_tol][0]
     tt = np.linspace(0.01, t_end, 400)
@@ -371,9 +389,9 @@ def time_path(page: Page, quick: bool) -> None:
         for k in PATH_KEYS:
             a = np.interp(tt, r.history["t"], r.history[k])
             b = np.interp(tt, ref.history["t"], ref.history[k])
-            errs.append(float(np.max(np.abs(a - b)) / abs(ref.summary[k])))
+            errs.append(float(np.max(np.abs(a - b)) / abs(ref.summary()[k])))
         worst = max(errs[PATH_KEYS.index(k)] for k in PATH_HELD)
-        if tol == 1e-4 and worst > PATH_TOL:
+        if tol == DEFAULT_TIME_TOL and worst > PATH_TOL:
             page.fail(f"the default time_tol's speed path error {worst:.2e} exceeds "
                       f"{PATH_TOL:g}")
         body.append([f"{tol:g}", str(r.statistics["steps"]), str(r.statistics["rejected_steps"]),
@@ -387,14 +405,12 @@ def time_path(page: Page, quick: bool) -> None:
                 *(f"path error, {k.replace('_', ' ')}" for k in PATH_KEYS),
                 "power balance"], body)
     page.para(
-        "The speeds' paths converge with the tolerance and are held to the target at the "
-        "default. The span tensions' paths converge more slowly: their largest "
-        "differences sit in the middle of the ramp (t of about 0.19 s), where the slip "
-        "fronts sweep across the arcs' nodes and every jump of a node between stick and "
-        "slip excites the spans' axial oscillation (about 2 ms period) a little "
-        "differently; measured on the default grid, the slack tension's path differs by "
-        "1.3e-3 between time_tol 1e-4 and 1e-6, and by 4e-4 between 1e-6 and 1e-7. "
-        "The end states agree to the grid's error whatever the tolerance.")
+        "The speeds' paths are held to the target at the default tolerance. The span "
+        "tensions' paths converge more slowly: their largest differences sit in the ramp, "
+        "where the slip fronts sweep across the arcs' nodes and every jump of a node "
+        "between stick and slip excites the spans' axial oscillation (about 2 ms period) "
+        "a little differently. The end states agree to the grid's error whatever the "
+        "tolerance.")
 
 
 def build(page: Page, quick: bool) -> None:

@@ -332,7 +332,8 @@ def solve_beam(P: DriveParams, omega1: float | None = None,
     Raises
     ------
     GrossSlipError
-        The load exceeds the beam drive's capacity (:func:`capacity`, in the message).
+        The load exceeds the beam drive's capacity
+        (:func:`beltsim.beltdrive.beam.capacity`, in the message).
     LiftOffError
         The contact pressure does not stay positive on the arcs.
     NoSolutionError

@@ -54,7 +54,8 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import NoSolutionError
-from .scene import Params, Scene
+from .scene import Scene
+from .validation import Params
 
 FIELDS = ("u", "theta", "strain", "tension", "moment", "friction")
 

@@ -22,7 +22,7 @@ name it and its default applies. The sections do not check their values; a scene
 does, when it is built (:meth:`beltsim.Scene.build`, :meth:`beltsim.Scene.replace`),
 with the same rules and one-line :class:`~beltsim.errors.SceneError` messages as a
 file, because it hands the same dictionary to the one validator
-(:func:`beltsim.problem.scene.validate`).
+(:func:`beltsim.problem.validation.validate`).
 
 The drive's quantities (``Motion.surface_speed``, ``Contact.max_friction``) are
 profiles: a number, a table of ``(time, value)`` rows (linear between rows, held

@@ -1,7 +1,7 @@
 """The rules a scene's keys follow, shared by every kind of scene.
 
 A straight belt (:mod:`beltsim.problem.validation`) and a closed drive
-(:mod:`beltsim.beltdrive.scene`) check their keys with the same rules, read the same
+(:class:`~beltsim.beltdrive.scene.DriveScene`) check their keys with the same rules, read the same
 profiles and tables and derive the belt's stiffness the same way; this module holds what
 they share, so that neither imports the other. Every rule raises
 :class:`~beltsim.errors.SceneError` with a one-line message naming the key and the rule.

@@ -41,8 +41,8 @@ from .validation import (
 
 __all__ = [
     "MIN_ELEMENTS", "OPTIONAL_SECTIONS", "REQUIRED_SECTIONS", "SCHEMA", "TOP_LEVEL_KEYS",
-    "Params", "Scene", "check_table", "final_value", "parse_assignment", "parse_toml",
-    "profile_extremes", "read_scene_file", "scene_names", "set_key", "validate",
+    "Scene", "check_table", "final_value", "parse_assignment", "parse_toml",
+    "profile_extremes", "read_scene_file", "scene_names", "set_key",
 ]
 
 S = TypeVar("S", bound=Section)
@@ -67,7 +67,8 @@ class Scene:
     Build it from a file (:meth:`load`), TOML text (:meth:`loads`), a nested dictionary
     (:meth:`from_dict`) or typed sections (:meth:`build`); derive others with
     :meth:`replace` (sections) or :meth:`with_overrides` (``SECTION.KEY=VALUE``). Every
-    way goes through :func:`~beltsim.problem.scene.validate`, so a scene that exists is a valid one.
+    way goes through :func:`~beltsim.problem.validation.validate`, so a scene that exists
+    is a valid one.
 
     Parameters
     ----------

@@ -3,7 +3,7 @@
 They live in ``runs/`` at the top of the repository, one copy each, which the build
 installs as the package ``beltsim.scenes`` (pyproject.toml); this module finds them the
 same way in a wheel and in an editable install. Which kind of scene a file holds is for
-:func:`beltsim.api.load_scene` to decide: this module reads text.
+:func:`beltsim.load_scene` to decide: this module reads text.
 """
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def shipped_text(name: str) -> str:
     Parameters
     ----------
     name : str
-        The scene's name, its file's stem (see :func:`scene_names`).
+        The scene's name, its file's stem (see :func:`beltsim.scene_names`).
 
     Returns
     -------

@@ -129,7 +129,8 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from ..errors import SceneError
-from .scene import Params, Scene
+from .scene import Scene
+from .validation import Params
 
 #: Largest eta = (h/2)^2 max(b1/a, f*/(|e0| sqrt(a b2))) of a thin belt (relative
 #: O(h^2) deviation of strains and friction totals from the bar limit).

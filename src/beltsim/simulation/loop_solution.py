@@ -2,10 +2,10 @@
 drive's figures (span tensions, speeds, slip arcs, torque, efficiency, powers) and the
 errors against the exact steady state.
 
-:class:`LoopSolution` is to a loop what :class:`~beltsim.simulation.solution.
-DiscreteSolution` is to the open layout: the run loop, the result, the writer and the
-plots read both through the same attributes (``x``, ``fields()``, ``summary()``,
-``errors()``, ``monitor``).
+:class:`LoopSolution` is to a loop what
+:class:`~beltsim.simulation.solution.DiscreteSolution` is to the open layout: the run
+loop, the result, the writer and the plots read both through the same attributes
+(``x``, ``fields()``, ``summary()``, ``errors()``, ``monitor``).
 """
 
 from __future__ import annotations

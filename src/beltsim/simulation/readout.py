@@ -89,6 +89,8 @@ class LoopReadout(Readout):
         self._sliding = 0
 
     def solution(self, state, t: float, transient: bool):
+        """The state read as the drive's solution (with the profiles' values at t in a
+        transient)."""
         return LoopSolution(self.disc, state, t if transient else None)
 
     def monitor(self, state) -> float:
@@ -121,6 +123,8 @@ class LoopReadout(Readout):
         return None
 
     def reference(self):
+        """The drive's exact steady state (the string's or the beam's, as the scene's
+        model), or None: a periodic drive, or a load beyond the capacity."""
         from ..beltdrive.beam import exact_state
 
         scene = self.disc.scene

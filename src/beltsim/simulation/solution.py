@@ -26,7 +26,7 @@ from ..physics.grid import Grid
 from ..physics.model import contact_stencil, traction
 from ..physics.reference import strain
 from ..problem.analytic import AnalyticSolution
-from ..problem.scene import Params
+from ..problem.validation import Params
 
 LAYER, FIT = 3, 3  # nodes of the discrete force layer at x2, and of the smooth fit
 

@@ -118,6 +118,7 @@ class LoopDiscretisation(Discretisation):
 
     @property
     def window(self) -> float:
+        """The loop's transit time (s): how long the belt takes once round it."""
         return self.params.geometry.loop_length / (self.params.omega1
                                                    * self.params.geometry.R1)
 

@@ -34,7 +34,8 @@ from ..physics.model import GYROSCOPIC_FORMS
 from ..problem import analytic
 from ..problem.analytic import decay_rates
 from ..problem.drive import largest_mismatch, period_of, profile_times, speed_ramped
-from ..problem.scene import Params, Scene
+from ..problem.scene import Scene
+from ..problem.validation import Params
 from . import registry
 
 DEFAULT_ELEMENTS = 600
