@@ -49,6 +49,9 @@ STEADY_REPEATS = 5
 #: loads of the gross-slip runs, as fractions of the string's capacity
 THRESHOLDS = {False: (0.95, 0.99, 1.01, 1.05), True: (0.95, 1.05)}
 QUICK_ELEMENTS = 200
+#: the quick page's runs from rest end where the default's do, with fewer steps: a loose
+#: local error damps the drive's rotational ringing (its path is the path study's job)
+QUICK_TIME_TOL = 1e-3
 
 
 def _cmd(*sets: str) -> str:
@@ -207,7 +210,8 @@ def default_grid(page: Page) -> None:
 
 
 def startup(page: Page, quick: bool) -> None:
-    grid = [("numerics.elements", QUICK_ELEMENTS)] if quick else []
+    grid = ([("numerics.elements", QUICK_ELEMENTS), ("numerics.time_tol", QUICK_TIME_TOL)]
+            if quick else [])
     where = f"{QUICK_ELEMENTS} elements" if quick else "the default grid"
     page.para(
         f"Time-accurate runs from rest (c = omega2 = 0, uniform tension N0) on {where}: "
@@ -222,7 +226,8 @@ def startup(page: Page, quick: bool) -> None:
         "damps it numerically and settles in fewer steps). Commands: `beltsim run "
         f"{SCENE} --set physics.model=string`, `beltsim run {SCENE}` (the beam) and "
         f"`beltsim run {SCENE} --set numerics.integrator=implicit`"
-        + (f", with `--set numerics.elements={QUICK_ELEMENTS}`" if quick else "") + ".")
+        + (f", with `--set numerics.elements={QUICK_ELEMENTS} --set "
+           f"numerics.time_tol={QUICK_TIME_TOL:g}`" if quick else "") + ".")
     keys = ("tight_tension", "slack_tension", "speed_loss", "slip_arc_driver",
             "slip_arc_driven", "slip_power")
     body = []
@@ -237,7 +242,7 @@ def startup(page: Page, quick: bool) -> None:
         e = r.errors()
         target = "met" if r.wall_time <= STARTUP_WALL else "not met on this machine"
         body.append([label, type(r.reference).__name__, status,
-                     fmt(float(r.history["t"][-1]), ".4g"), str(r.statistics["steps"]),
+                     fmt(r.simulated_time, ".4g"), str(r.statistics["steps"]),
                      str(r.statistics.get("newton_iterations", "")),
                      str(r.statistics.get("rejected_steps", "")),
                      f"{r.wall_time:.3g} ({target})",
@@ -253,7 +258,8 @@ def startup(page: Page, quick: bool) -> None:
 
 
 def threshold(page: Page, quick: bool) -> None:
-    grid = [("numerics.elements", QUICK_ELEMENTS)] if quick else []
+    grid = ([("numerics.elements", QUICK_ELEMENTS), ("numerics.time_tol", QUICK_TIME_TOL)]
+            if quick else [])
     scene = _string(grid)
     cap = capacity(scene.params)
     page.para(
@@ -262,7 +268,8 @@ def threshold(page: Page, quick: bool) -> None:
         "rest of the string model at loads about it: below it the run must reach its "
         "steady state, above it end in gross slip, and the steady solver must refuse the "
         "load. Command: `beltsim run " + SCENE + " --set physics.model=string --set "
-        "drive.load_torque=M2" + (f" --set numerics.elements={QUICK_ELEMENTS}" if quick
+        "drive.load_torque=M2" + (f" --set numerics.elements={QUICK_ELEMENTS} --set "
+                                  f"numerics.time_tol={QUICK_TIME_TOL:g}" if quick
                                   else "") + "`.")
     body = []
     for frac in THRESHOLDS[quick]:
@@ -287,7 +294,7 @@ def threshold(page: Page, quick: bool) -> None:
             except GrossSlipError as exc:
                 steady = "refused: " + str(exc)
         body.append([f"{frac:g}", f"{load:.5g}", status, r.reason or "",
-                     f"{float(r.history['t'][-1]):.4g}", arc, steady])
+                     f"{r.simulated_time:.4g}", arc, steady])
     page.table(["load / capacity", "load [N m]", "status", "reason", "end time [s]",
                 "driver's slip arc, run / analytic [rad]", "steady solver"], body)
 
@@ -329,8 +336,8 @@ def balance(page: Page, rows: list[dict], quick: bool) -> None:
 #: the default scheme's time tolerance (esdirk3)
 DEFAULT_TIME_TOL = SCHEME_TIME_TOLS["esdirk3"]
 #: time tolerances of the path study and its reference (numerics.time_tol)
-TIME_TOLS = {False: (1e-3, 1e-4, DEFAULT_TIME_TOL), True: (1e-3, DEFAULT_TIME_TOL)}
-TIME_REFERENCE = {False: 1e-6, True: 2e-6}
+TIME_TOLS = {False: (1e-3, 1e-4, DEFAULT_TIME_TOL), True: (1e-2, 1e-3)}
+TIME_REFERENCE = {False: 1e-6, True: 1e-4}
 PATH_KEYS = ("tight_tension", "slack_tension", "belt_speed", "driven_speed")
 #: the paths held to PATH_TOL at the default tolerance (the tensions are reported: see the
 #: page's note on the spans' oscillation)
@@ -357,7 +364,7 @@ def _energy_mismatch(r) -> float:
 
 def time_path(page: Page, quick: bool) -> None:
     grid = [("numerics.elements", QUICK_ELEMENTS)] if quick else []
-    t_end = 0.5
+    t_end = 0.3 if quick else 0.5
     common = [*grid, ("numerics.t_end", t_end), ("numerics.steady_tol", 1e-30)]
     ref_tol = TIME_REFERENCE[quick]
     page.para(

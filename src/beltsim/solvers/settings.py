@@ -261,7 +261,7 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
     settle = max([ramp_time, *(v[-1][0] for v in (scene.drive["driver_speed"],
                                                   scene.drive["load_torque"])
                                if isinstance(v, list))])
-    dt = nm.get("dt", transit / 4.0)
+    dt = nm.get("dt", max(ramp_time, transit) / 50.0)  # the first step, as an open layout's
     t_end = nm.get("t_end", settle + 40.0 * transit)
     if dt > t_end:
         raise SceneError("numerics.dt", f"must be <= numerics.t_end = {t_end!r}, got {dt!r}")
