@@ -40,11 +40,6 @@ def flat(*overrides):
 
 
 STRING = ("physics.model", "string")
-#: the runs below test where a run ends, not its path (tests/test_paths.py and the power
-#: balance below test paths): a loose local error lets the steps damp the drive's 88 Hz
-#: ringing, where the default tolerance follows it to its decay, and ends on the same
-#: discrete steady state
-END_STATE = ("numerics.time_tol", 1e-3)
 
 
 # geometry -------------------------------------------------------------------------
@@ -226,7 +221,7 @@ def test_steady_power_balance_and_torques():
 
 @pytest.mark.verification
 def test_start_up_from_rest_ends_on_the_analytic_state():
-    r = simulate(flat(STRING, END_STATE))
+    r = simulate(flat(STRING))
     assert r.status is RunStatus.CONVERGED
     e = r.errors()
     # measured on 800 elements: tensions 1.3e-6, 2.1e-6; speed loss 7.0e-7; slip arcs
@@ -241,7 +236,7 @@ def test_start_up_from_rest_ends_on_the_analytic_state():
 @pytest.mark.verification
 def test_load_step_ends_on_the_new_loads_state():
     # 400 elements: the grid's errors (second order; 1e-6 on 800 elements) stay below 1e-5
-    scene = flat(STRING, END_STATE, ("numerics.elements", 400),
+    scene = flat(STRING, ("numerics.elements", 400),
                  ("drive.load_torque", [[0.0, 0.0], [0.3, 30.0], [0.6, 30.0], [0.61, 60.0]]))
     r = simulate(scene)
     assert r.status is RunStatus.CONVERGED
@@ -259,9 +254,9 @@ def test_load_step_ends_on_the_new_loads_state():
 def test_gross_slip_threshold():
     P = flat(STRING).params
     cap = capacity(P)
-    above = simulate(flat(STRING, END_STATE, ("drive.load_torque", 1.05 * cap)))
+    above = simulate(flat(STRING, ("drive.load_torque", 1.05 * cap)))
     assert above.status is RunStatus.GROSS_SLIP and "whole wrap" in above.reason
-    below = simulate(flat(STRING, END_STATE, ("drive.load_torque", 0.95 * cap)))
+    below = simulate(flat(STRING, ("drive.load_torque", 0.95 * cap)))
     assert below.status is RunStatus.CONVERGED
     assert below.summary()["slip_arc_driver"] == pytest.approx(
         solve_string(P, M2=0.95 * cap).phi_s, rel=1e-3)
@@ -285,8 +280,7 @@ def test_cli_runs_and_refuses_drives(tmp_path):
     assert res.returncode == 2 and "closed drive" in res.stderr
     # a torque sweep past the capacity (98.4 N m): gross slip is no steady state, exit 1
     # as 'beltsim run' gives (outputs.md, exit statuses), with every output written
-    res = cli("sweep", "drive_flat", "--set", "physics.model=string", "--set",
-              "numerics.time_tol=1e-3", "--vary",
+    res = cli("sweep", "drive_flat", "--set", "physics.model=string", "--vary",
               "drive.load_torque=40,110", "--workers", "1", "--out", tmp_path / "s")
     assert res.returncode == 1, res.stderr
     assert "gross slip" in res.stdout and (tmp_path / "s" / "characteristic.png").is_file()

@@ -139,6 +139,7 @@ def test_undamped_run_is_honest():
     assert res.history["rate"][-1] > 1e-4  # still ringing at 0.1 s
 
 
+@pytest.mark.long
 def test_the_central_forms_path_converges_at_second_order_in_space():
     """paper_slip to 0.15 s with the central gyroscopic form (esdirk3 at time_tol 1e-7, a
     time error near 1e-6), the total friction after the ramp (t >= 0.1 s) against the same

@@ -46,6 +46,7 @@ def test_resume_reaches_the_same_state_as_an_uninterrupted_run(tmp_path, integra
 
 
 @pytest.mark.cli
+@pytest.mark.long
 def test_sigterm_writes_a_checkpoint_and_resume_finishes(tmp_path):
     """The CLI path with a real signal: exit 130, a checkpoint, no summary; the resumed
     run ends where an uninterrupted one does."""

@@ -1,5 +1,6 @@
-"""The straight belt's scene rules: its sections and keys, :func:`validate` and the
-derived physical data (:class:`Params`).
+"""The straight belt's scene rules: its sections and keys,
+:func:`~beltsim.problem.validation.validate` and the derived physical data
+(:class:`~beltsim.problem.validation.Params`).
 
 Validation happens in one place for files, dictionaries and ``--set`` overrides alike,
 and every rule raises :class:`~beltsim.errors.SceneError` with a one-line message that
