@@ -33,6 +33,7 @@ from ..problem.rules import (
     check_table,
     number,
     profile_extremes,
+    set_scene_key,
     show,
 )
 from ..problem.tomlio import assignments, parse_toml, read_scene_file, toml_value
@@ -206,18 +207,7 @@ def validate(data: dict) -> dict:
 def set_key(data: dict, key: str, value) -> None:
     """Set ``SECTION.KEY`` (or ``title``) in a drive scene's tables; the section must be
     one a drive has (:func:`validate` checks the key and its value)."""
-    if key == "title":
-        data["title"] = value
-        return
-    if "." not in key:
-        raise SceneError(key, f"expected SECTION.KEY (sections: {', '.join(SCHEMA)})")
-    section, name = key.split(".", 1)
-    if section not in SCHEMA:
-        raise SceneError(key, f"unknown section [{section}] of a drive scene "
-                         f"(sections: {', '.join(SCHEMA)})")
-    if (section, name) in RETIRED:
-        raise SceneError(key, RETIRED[section, name])
-    data.setdefault(section, {})[name] = value
+    set_scene_key(data, key, value, SCHEMA, "a drive scene", known_keys=False)
 
 
 def max_rim_speed(data: dict) -> float:

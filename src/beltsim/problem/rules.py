@@ -230,6 +230,32 @@ RETIRED = {
 }
 
 
+def set_scene_key(data: dict, key: str, value, schema: dict, kind: str = "",
+                  known_keys: bool = True) -> None:
+    """Set ``SECTION.KEY`` (or ``title``) in a scene's tables.
+
+    The section must be one of ``schema``'s, the key not a retired one and, with
+    ``known_keys``, one the section knows; ``kind`` names the kind of scene in the
+    message ("a drive scene"). The value is checked when the tables are validated.
+    """
+    if key == "title":
+        data["title"] = value
+        return
+    sections = ", ".join(schema)
+    if "." not in key:
+        raise SceneError(key, f"expected SECTION.KEY (sections: {sections})")
+    section, name = key.split(".", 1)
+    if section not in schema:
+        of = f" of {kind}" if kind else ""
+        raise SceneError(key, f"unknown section [{section}]{of} (sections: {sections})")
+    if (section, name) in RETIRED:
+        raise SceneError(key, RETIRED[section, name])
+    if known_keys and name not in schema[section]:
+        raise SceneError(key, f"unknown key (known in [{section}]: "
+                         f"{', '.join(schema[section])})")
+    data.setdefault(section, {})[name] = value
+
+
 def derived_stiffness(d: dict) -> dict:
     """The belt's stiffness and inertia per unit length: a, b1, b2, rho and I.
 

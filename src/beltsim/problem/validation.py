@@ -24,6 +24,7 @@ from .rules import (
     derived_stiffness,
     final_value,
     profile_extremes,
+    set_scene_key,
     show,
 )
 
@@ -263,18 +264,5 @@ def params_of(d: dict) -> Params:
 
 def set_key(data: dict, key: str, value) -> None:
     """Set ``SECTION.KEY`` in a scene dict; the key must be one the schema knows."""
-    if key == "title":
-        data["title"] = value
-        return
-    if "." not in key:
-        raise SceneError(key, f"expected SECTION.KEY (sections: {', '.join(SCHEMA)})")
-    section, name = key.split(".", 1)
-    if section not in SCHEMA:
-        raise SceneError(key, f"unknown section [{section}] (sections: {', '.join(SCHEMA)})")
-    if (section, name) in RETIRED:
-        raise SceneError(key, RETIRED[section, name])
-    if name not in SCHEMA[section]:
-        raise SceneError(key, f"unknown key (known in [{section}]: "
-                         f"{', '.join(SCHEMA[section])})")
-    data.setdefault(section, {})[name] = value
+    set_scene_key(data, key, value, SCHEMA)
 

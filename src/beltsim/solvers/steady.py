@@ -95,14 +95,8 @@ class SteadyScheme(NewtonScheme):
         coarse.grid, index = coarsened(d.grid, COARSENING)
         coarse.mesh = mesh_of(coarse.grid)
         coarse.loads = Loads(*(q if q.ndim == 1 else q[:, index] for q in d.loads))
-        level = SteadyScheme(coarse)
-        coarse_state = coarse.new_state()
-        level.solve(coarse_state)
-        self.steps += level.steps
-        stats, level_stats = self.work.stats[0], level.work.stats[0]
-        for key in ("newton_iterations", "line_search_cuts"):
-            stats[key] += level_stats[key]
-        before = int(stats["newton_iterations"])
+        level, coarse_state, before = self._coarse_level(coarse)
+        stats = self.work.stats[0]
         interpolate(coarse.grid, coarse_state, d.grid, state)
         if not self._stage(state, 1.0, self._stage_settings):
             raise NumericalError(
@@ -112,6 +106,19 @@ class SteadyScheme(NewtonScheme):
                 kind=FailureKind.CONTINUATION, t=0.0, quantity="newton")
         self.grid_iterations = [*level.grid_iterations,
                                 int(stats["newton_iterations"]) - before]
+
+    def _coarse_level(self, coarse):
+        """The steady state of a coarser discretisation (grid sequencing), its steps and
+        Newton counts added to this scheme's; returns the coarse scheme, its state and the
+        Newton iterations counted so far."""
+        level = SteadyScheme(coarse)
+        coarse_state = coarse.new_state()
+        level.solve(coarse_state)
+        self.steps += level.steps
+        stats, level_stats = self.work.stats[0], level.work.stats[0]
+        for key in ("newton_iterations", "line_search_cuts"):
+            stats[key] += level_stats[key]
+        return level, coarse_state, int(stats["newton_iterations"])
 
     def _solve_from_rest(self, state) -> None:
         """Continuation in v - c (after one in v_reg for a saturating law); the number of
@@ -154,14 +161,8 @@ class SteadyScheme(NewtonScheme):
         if d.grid.n_elements > COARSEST * LOOP_ELEMENTS:
             coarse = d.with_grid(LoopGrid.build(d.params.geometry.lengths,
                                                 d.grid.n_elements // COARSENING))
-            level = SteadyScheme(coarse)
-            coarse_state = coarse.new_state()
-            level.solve(coarse_state)
-            self.steps += level.steps
-            stats, level_stats = self.work.stats[0], level.work.stats[0]
-            for key in ("newton_iterations", "line_search_cuts"):
-                stats[key] += level_stats[key]
-            before = int(stats["newton_iterations"])
+            level, coarse_state, before = self._coarse_level(coarse)
+            stats = self.work.stats[0]
             interpolate_loop(coarse.grid, coarse_state, d.grid, d.mesh.cn, state)
             self._loop_stage(state, model, "from the steady state of "
                              f"{coarse.grid.n_elements} elements")
