@@ -19,6 +19,17 @@ from .registry import register
 
 
 @njit(cache=True)
+def restore(state, old):
+    """Put back the step's start: the fields, their rates, the friction unknowns and a
+    loop's globals."""
+    for j in range(state.u.shape[0]):
+        state.u[j], state.theta[j] = old.u[j], old.theta[j]
+        state.ud[j], state.td[j], state.lam[j] = old.ud[j], old.td[j], old.lam[j]
+    for k in range(state.g.shape[0]):
+        state.g[k], state.gd[k] = old.g[k], old.gd[k]
+
+
+@njit(cache=True)
 def advance_backward_euler(state, old, t, t_stop, dt, dt_nominal, max_steps, mesh, p, drive,
                            loads, scales, settings, w):
     """Backward-Euler steps from t until t >= t_stop (or max_steps).
@@ -28,7 +39,9 @@ def advance_backward_euler(state, old, t, t_stop, dt, dt_nominal, max_steps, mes
     """
     u, th, lam, ud, td = state.u, state.theta, state.lam, state.ud, state.td
     uo, tho, udo, tdo, lamo = old.u, old.theta, old.ud, old.td, old.lam
+    g, gd, go, gdo = state.g, state.gd, old.g, old.gd
     N = u.shape[0] - 1
+    off = mesh.off
     steps = 0
     good = 0
     dt_min = dt_nominal * 1e-7
@@ -39,12 +52,16 @@ def advance_backward_euler(state, old, t, t_stop, dt, dt_nominal, max_steps, mes
             udo[j] = ud[j]
             tdo[j] = td[j]
             lamo[j] = lam[j]
+        for k in range(g.shape[0]):
+            go[k], gdo[k] = g[k], gd[k]
         h = dt
         inv = 1.0 / h
         # predictor: constant local velocity over the step
-        for j in range(1, N):
+        for j in range(off, N + 1 - off):
             u[j] = uo[j] + h * udo[j]
             th[j] = tho[j] + h * tdo[j]
+        for k in range(g.shape[0]):
+            g[k] = go[k] + h * gdo[k]
         ok = newton(state, old, inv, t + h, mesh, p, drive, loads, scales, settings, w)
         if ok:
             finite = True
@@ -53,9 +70,12 @@ def advance_backward_euler(state, old, t, t_stop, dt, dt_nominal, max_steps, mes
                 td[j] = (th[j] - tho[j]) * inv
                 if not (np.isfinite(u[j]) and np.isfinite(th[j])):
                     finite = False
+            for k in range(g.shape[0]):
+                gd[k] = (g[k] - go[k]) * inv
+                if not np.isfinite(g[k]):
+                    finite = False
             if not finite:
-                for j in range(N + 1):
-                    u[j], th[j], ud[j], td[j], lam[j] = uo[j], tho[j], udo[j], tdo[j], lamo[j]
+                restore(state, old)
                 return NONFINITE, t, dt, steps
             t += h
             steps += 1
@@ -65,8 +85,7 @@ def advance_backward_euler(state, old, t, t_stop, dt, dt_nominal, max_steps, mes
                 good = 0
         else:
             w.stats[0].failed_steps += 1
-            for j in range(N + 1):
-                u[j], th[j], ud[j], td[j], lam[j] = uo[j], tho[j], udo[j], tdo[j], lamo[j]
+            restore(state, old)
             dt *= 0.25
             good = 0
             if dt < dt_min:
@@ -79,7 +98,6 @@ class PseudoScheme(NewtonScheme):
     """Backward Euler with step cutting on Newton failure; not time-accurate."""
 
     name = "pseudo"
-    closed = False  # open layouts only, for now
     time_accurate = False
     accelerated = True
 

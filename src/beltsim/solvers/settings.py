@@ -50,6 +50,9 @@ ELEMENTS_PER_LAYER = 10.0
 DEFAULT_INTEGRATOR = "esdirk3"
 TIME_TOLS = {"esdirk3": 2e-5, "implicit": 6e-6}
 DEFAULT_TIME_TOL = TIME_TOLS[DEFAULT_INTEGRATOR]
+#: the first step of an adaptive scheme (the fixed step of the pseudo-transient one): this
+#: fraction of the ramp time or the transit time, whichever is longer
+FIRST_STEPS = 50.0
 MIN_MISMATCH = 1e-8  # smallest nonzero |v/c - 1| a run accepts
 DEFAULT_MAX_WORK = 2e10  # node-steps of an explicit run
 EXPLICIT_RATE = 8e7  # node-steps per second of the explicit kernel (bench), for messages
@@ -109,7 +112,7 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
     refine = min(1.0, max(MIN_REFINE, (default_elements(P) / elements) ** 2))
     transit = P.L / P.c
     ramp_time = nm.get("ramp_time", 2.0 * transit)
-    dt = nm.get("dt", max(ramp_time, transit) / 50.0)
+    dt = nm.get("dt", max(ramp_time, transit) / FIRST_STEPS)
     t_end = nm.get("t_end", settle_time(scene, ramp_time) + 400.0 * transit)
     if dt > t_end:
         raise SceneError("numerics.dt", f"must be <= numerics.t_end = {t_end!r}, got {dt!r}")
@@ -149,16 +152,8 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         delta = nm.get("adhesion_layer", DEFAULT_ADHESION_LAYER * P.L * refine)
         law, regularisation = "linear", 1.0
         friction_scale = P.B / (P.c * delta)
-    accelerated = registry.get(integrator).accelerated
-    if "acceleration" in nm and not accelerated:
-        allowed = " | ".join(f'"{n}"' for n in registry.names()
-                             if registry.get(n).accelerated)
-        raise SceneError("numerics.acceleration", f"only for numerics.integrator = {allowed} "
-                         f"(the damping of a time-accurate run is physics.damping)")
-    acceleration = 0.0
-    if accelerated and P.inertia:
-        omega1 = math.pi * P.B / (P.L * math.sqrt(P.rho * P.b1))
-        acceleration = nm.get("acceleration", 2.0 * omega1)
+    acceleration = acceleration_of(nm, integrator, P.inertia,
+                                   math.pi * P.B / (P.L * math.sqrt(P.rho * P.b1)))
     gyroscopic = nm.get("gyroscopic", "upwind")
     if "max_work" in nm and integrator != "explicit":
         raise SceneError("numerics.max_work", 'only for numerics.integrator = "explicit" (the '
@@ -179,6 +174,19 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         max_work=nm.get("max_work", DEFAULT_MAX_WORK),
         gyroscopic=gyroscopic,
     )
+
+
+def acceleration_of(nm: dict, integrator: str, inertia: bool, omega1: float) -> float:
+    """numerics.acceleration (1/s) with its default, twice the layout's lowest string
+    frequency ``omega1``: a damping that speeds the approach of a scheme that does not
+    follow the path (none elsewhere: a time-accurate run's damping is physics.damping)."""
+    accelerated = registry.get(integrator).accelerated
+    if "acceleration" in nm and not accelerated:
+        allowed = " | ".join(f'"{n}"' for n in registry.names()
+                             if registry.get(n).accelerated)
+        raise SceneError("numerics.acceleration", f"only for numerics.integrator = {allowed} "
+                         f"(the damping of a time-accurate run is physics.damping)")
+    return nm.get("acceleration", 2.0 * omega1) if accelerated and inertia else 0.0
 
 
 def available_memory() -> float | None:
@@ -265,11 +273,14 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
     settle = max([ramp_time, *(v[-1][0] for v in (scene.drive["driver_speed"],
                                                   scene.drive["load_torque"])
                                if isinstance(v, list))])
-    dt = nm.get("dt", max(ramp_time, transit) / 50.0)  # the first step, as an open layout's
+    dt = nm.get("dt", max(ramp_time, transit) / FIRST_STEPS)
     t_end = nm.get("t_end", settle + 40.0 * transit)
     if dt > t_end:
         raise SceneError("numerics.dt", f"must be <= numerics.t_end = {t_end!r}, got {dt!r}")
     creep = creep_speed(P)
+    # the lowest string frequency of the longer free span (pi sqrt(N0 / rho) / l)
+    omega1 = math.pi * math.sqrt(P.N0 / P.rho) / max(P.geometry.lengths[1::2]) \
+        if P.rho > 0.0 else 0.0
     friction_scale = 1.0
     if P.mu is None:
         # adhesion's reaction, scaled as the pretension's pressure on the driver
@@ -282,7 +293,8 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
     return Numerics(
         integrator=integrator, elements=elements, grading=1.0, dt=dt, t_end=t_end,
         ramp_time=ramp_time, friction_law=law, regularisation=regularisation,
-        friction_scale=friction_scale, acceleration=0.0,
+        friction_scale=friction_scale,
+        acceleration=acceleration_of(nm, integrator, P.inertia, omega1),
         steady_tol=nm.get("steady_tol", 1e-7),
         snapshot_interval=nm.get("snapshot_interval"),
         newton_tol=nm.get("newton_tol", 1e-9),
