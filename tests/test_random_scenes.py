@@ -230,3 +230,35 @@ def test_jobs_give_the_same_rows_in_the_same_order(monkeypatch):
     assert len(runs[3][2]) == 3
     skipped = rs.random_study(3, 5, jobs=2, max_wall=1e-9)
     assert {r["status"] for r in skipped} == {rs.SKIPPED}
+
+
+# closed drives ---------------------------------------------------------------------
+
+def test_every_drawn_drive_is_valid_and_loads_within_its_capacity():
+    from beltsim.beltdrive.analytic import capacity
+    from beltsim.beltdrive.scene import DriveScene
+    drives = rs.draw_scenes(60, seed=3, drives=True)
+    for d in drives:
+        P = d.params
+        # the file written for a failure reads back as the same drive
+        assert DriveScene(tomllib.loads(d.to_toml())).to_dict() == d.to_dict()
+        # the load was drawn as 0.1 .. 0.9 of the capacity (rounded to 4 digits)
+        assert 0.1 * 0.999 <= P.M2 / capacity(P) <= 0.9 * 1.001
+        if P.inertia:
+            rim = P.omega1 * P.geometry.R1
+            assert P.rho * rim * rim <= 0.5 * P.N0 * 1.001
+    assert {d.params.model for d in drives} == {"beam", "string"}
+    assert {d.params.inertia for d in drives} == {True, False}
+    # drive i of a seed does not depend on how many are drawn, and not on the straight
+    # scenes of that seed
+    assert rs.draw_scenes(4, seed=3, drives=True)[3].to_toml() == drives[3].to_toml()
+
+
+def test_a_random_drive_runs_by_every_applicable_scheme_and_passes():
+    """The campaign's cells on drives: each applicable scheme from rest to the exact
+    state within stability.DRIVE_BOUNDS (a coarse grid: 200 elements)."""
+    rows = rs.random_study(1, 1, extra=[("numerics.elements", 200)], drives=True)
+    assert {r["scheme"] for r in rows} == set(solvers.names())
+    assert not [r for r in rows if rs.failed(r)], rows
+    ran = [r for r in rows if r["status"] == CellStatus.CONVERGED.value]
+    assert ran and all(math.isfinite(r["error_tight_tension"]) for r in ran)

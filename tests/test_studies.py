@@ -8,7 +8,7 @@ import pytest
 from beltsim.api import load_scene
 from beltsim.physics.friction import LINEAR
 from beltsim.simulation.controller import Simulation
-from beltsim.studies import convergence
+from beltsim.studies import convergence, stability
 from benchmarks import peers
 from helpers import ERROR_FACTOR, cli, module, scene_path
 
@@ -240,3 +240,18 @@ def test_a_discrete_reference_measures_states_on_its_own_grid():
     assert err["u"] == pytest.approx(1e-4) and err["u"] > DISCRETE_BOUNDS["u"]
     with pytest.raises(ValueError, match="own grid"):
         ref.fields(sol.x[:-1])
+
+
+@pytest.mark.parametrize("case", [stability.STABILITY_CASES[2], stability.DRIVE_CASES[0]],
+                         ids=["paper slip", "drive"])
+def test_a_coarse_cell_reaches_its_grids_steady_state_on_either_layout(case):
+    """A stability cell of each layout, on a coarse grid against the steady scheme's state
+    on that grid: the layout's own errors within its DISCRETE_BOUNDS."""
+    cell = stability.stability_cell(case, "esdirk3", extra=[("numerics.elements", 60)],
+                                    discrete=True)
+    assert cell["status"] is stability.CellStatus.CONVERGED, cell["reason"]
+    errors = {k for k, v in cell.items() if k.startswith("error_") and np.isfinite(v)}
+    layout = ("error_tight_tension" in errors, "error_total_friction" in errors)
+    assert layout == ((True, False) if case in stability.DRIVE_CASES else (False, True))
+    md = stability.stability_markdown([{"case": case.name, **cell}])
+    assert case.name in md and md.count("\n|") >= 2

@@ -41,20 +41,29 @@ from collections import Counter
 import numpy as np
 
 from beltsim import solvers
+from beltsim.api import is_drive_scene
 from beltsim.errors import BeltsimError
 from beltsim.problem.scene import Scene
+from beltsim.simulation.readout import readout_class
 from beltsim.simulation.result import RunStatus
-from beltsim.studies.convergence import ERROR_KEYS
-from beltsim.studies.stability import ACCEPTED, BOUNDS, Case, CellStatus, stability_cell
+from beltsim.studies.stability import (
+    ACCEPTED,
+    BOUNDS,
+    DRIVE_BOUNDS,
+    Case,
+    CellStatus,
+    error_columns,
+    stability_cell,
+)
+from validation.random_drives import draw_drive
 
 SKIPPED = "skipped"  # not started: the run's --max-wall was spent
 CRASHED = "crashed"  # an exception that is not one of beltsim's own errors (a bug)
 #: The slip start's bound in mean element lengths L / N (:func:`scene_bounds`)
 SLIP_START_ELEMENTS = 5.0
-#: Columns of random.csv.
+#: Columns of random.csv before the errors (the layout's) and the reason.
 COLUMNS = ("index", "scheme", "status", "reason_key", "friction", "inertia", "damping",
-           "mismatch", "speed_ratio", "elements", "dt", "steps", "wall_time",
-           "elapsed") + tuple(f"error_{k}" for k in ERROR_KEYS) + ("reason",)
+           "mismatch", "speed_ratio", "elements", "dt", "steps", "wall_time", "elapsed")
 TEXT_COLUMNS = {"index", "scheme", "status", "reason_key", "friction", "inertia", "elements",
                 "steps", "reason"}
 INTERRUPTED = "interrupted (SIGINT)"  # the reason of cells skipped after a Ctrl-C
@@ -114,8 +123,17 @@ def draw_scene(seed: int, index: int) -> Scene:
     return Scene.from_dict(data)
 
 
-def draw_scenes(n: int, seed: int) -> list[Scene]:
-    return [draw_scene(seed, i) for i in range(n)]
+def draw_scenes(n: int, seed: int, drives: bool = False) -> list:
+    """Scenes (or, ``drives``, closed drives: :func:`validation.random_drives.draw_drive`)
+    0 .. n - 1 of ``seed``."""
+    draw = draw_drive if drives else draw_scene
+    return [draw(seed, i) for i in range(n)]
+
+
+def _no_errors(scene) -> dict:
+    """The error columns of the scene's layout, all nan (a cell that did not run)."""
+    return {f"error_{k}": math.nan
+            for k in readout_class(is_drive_scene(scene)).error_keys}
 
 
 def scene_case(scene: Scene) -> Case:
@@ -142,7 +160,8 @@ def ringing_span(scene: Scene, scheme: str, extra=()) -> list[tuple[str, float]]
     from beltsim.solvers.settings import DEFAULT_MAX_WORK, resolve
 
     P = scene.params
-    if not (P.inertia and P.damping == 0.0 and solvers.get(scheme).time_accurate):
+    if (is_drive_scene(scene) or not (P.inertia and P.damping == 0.0
+                                      and solvers.get(scheme).time_accurate)):
         return []
     try:
         num = resolve(scene.with_overrides(list(extra)))
@@ -170,7 +189,7 @@ def random_cell(scene: Scene, index: int, scheme: str, extra=()) -> dict:
         cell = {"scheme": scheme, "status": CRASHED,
                 "reason": f"{type(exc).__name__}: {exc}".replace("\n", " "),
                 "reason_key": type(exc).__name__, "dt": math.nan, "steps": 0,
-                "wall_time": math.nan, **{f"error_{k}": math.nan for k in ERROR_KEYS}}
+                "wall_time": math.nan, **_no_errors(scene)}
     P = scene.params
     if (cell["status"] is CellStatus.NOT_CONVERGED and P.inertia and P.damping == 0.0
             and cell["reason_key"] == RunStatus.REACHED_END.value):
@@ -185,7 +204,8 @@ def random_cell(scene: Scene, index: int, scheme: str, extra=()) -> dict:
 
 
 def scene_bounds(scene: Scene, elements: int) -> dict:
-    """stability.BOUNDS with the slip start's (in metres) scaled to the grid.
+    """stability.BOUNDS with the slip start's (in metres) scaled to the grid (a drive:
+    stability.DRIVE_BOUNDS).
 
     The paper's 5 mm on 1000 elements over 1 m are SLIP_START_ELEMENTS mean element
     lengths: the slip start's error is a fraction of an element, so on a long belt a
@@ -193,6 +213,8 @@ def scene_bounds(scene: Scene, elements: int) -> dict:
     stay: they hold on the default grid, which resolves each scene's shortest decay
     length as it does the paper's.
     """
+    if is_drive_scene(scene):
+        return dict(DRIVE_BOUNDS)
     out = dict(BOUNDS)
     out["slip_start"] = SLIP_START_ELEMENTS * scene.params.L / elements
     return out
@@ -200,8 +222,17 @@ def scene_bounds(scene: Scene, elements: int) -> dict:
 
 def describe(scene: Scene, extra=()) -> dict:
     """What a failure is usually about: friction, inertia, damping, v/c - 1, c / c_low
-    (0 without inertia) and the grid."""
+    (0 without inertia) and the grid; a drive's speed ratio is rho c^2 / N0 (its
+    mismatch nan)."""
     P = scene.params
+    if is_drive_scene(scene):
+        from beltsim.solvers.settings import LOOP_ELEMENTS
+
+        rim = P.omega1 * P.geometry.R1
+        return {"friction": P.friction, "inertia": int(P.inertia), "damping": P.damping,
+                "mismatch": math.nan, "speed_ratio": P.rho * rim * rim / P.N0,
+                "elements": dict(extra).get("numerics.elements", scene.numerics.get(
+                    "elements", LOOP_ELEMENTS))}
     return {"friction": P.friction, "inertia": int(P.inertia), "damping": P.damping,
             "mismatch": P.e0, "speed_ratio": P.c / min(P.critical_speeds),
             "elements": _elements(scene, extra)}
@@ -222,7 +253,7 @@ FIRST_PASS_SHARE = 0.5
 
 
 def random_study(n: int, seed: int, schemes=None, extra=(), max_wall=None, progress=None,
-                 on_failure=None, jobs: int = 1) -> list[dict]:
+                 on_failure=None, jobs: int = 1, drives: bool = False) -> list[dict]:
     """Every drawn scene by every registered scheme, one row per cell in scene order.
 
     The schemes of DEFERRED run in a second pass over the scenes the first pass reached.
@@ -231,12 +262,15 @@ def random_study(n: int, seed: int, schemes=None, extra=(), max_wall=None, progr
     on_failure(scene, rows) is called at each failed cell with the scene's rows so far.
     With jobs > 1 the cells run in a pool of that many processes (:func:`_parallel_study`):
     the same cells, rows and callbacks in the same order, only the wall times differ.
+    ``drives``: closed drives (:func:`validation.random_drives.draw_drive`) instead of
+    straight belts.
     """
     if jobs > 1:
-        return _parallel_study(n, seed, schemes, extra, max_wall, progress, on_failure, jobs)
+        return _parallel_study(n, seed, schemes, extra, max_wall, progress, on_failure, jobs,
+                               drives)
     start, stop = time.perf_counter(), ""
     schemes = tuple(schemes or solvers.names())
-    scenes = [draw_scene(seed, i) for i in range(n)]
+    scenes = draw_scenes(n, seed, drives)
     done: dict[tuple[int, str], dict] = {}
     first = [s for s in schemes if s not in DEFERRED]
     second = [s for s in schemes if s in DEFERRED]
@@ -280,16 +314,15 @@ def _wall_stop(stop, reached, start, max_wall, share, group, first, i, scheme):
 def _skipped(scene, i, scheme, reason, extra) -> dict:
     return {"index": i, "scheme": scheme, "status": SKIPPED, "reason": reason,
             "reason_key": "", **describe(scene, extra), "dt": math.nan, "steps": 0,
-            "wall_time": math.nan, "elapsed": 0.0,
-            **{f"error_{k}": math.nan for k in ERROR_KEYS}}
+            "wall_time": math.nan, "elapsed": 0.0, **_no_errors(scene)}
 
 
-def _cell_task(seed, i, scheme, extra):
+def _cell_task(seed, i, scheme, extra, drives):
     """One cell in a worker process (the scene is drawn there: only numbers travel)."""
-    return random_cell(draw_scene(seed, i), i, scheme, extra)
+    return random_cell((draw_drive if drives else draw_scene)(seed, i), i, scheme, extra)
 
 
-def _parallel_study(n, seed, schemes, extra, max_wall, progress, on_failure, jobs):
+def _parallel_study(n, seed, schemes, extra, max_wall, progress, on_failure, jobs, drives):
     """random_study on a pool of `jobs` processes, with its rules: cells are started in
     scene order, at most `jobs` at a time, and none after the pass's share of max_wall
     (the second pass runs on the scenes whose first cell the first pass started); rows,
@@ -298,7 +331,7 @@ def _parallel_study(n, seed, schemes, extra, max_wall, progress, on_failure, job
 
     start = time.perf_counter()
     schemes = tuple(schemes or solvers.names())
-    scenes = [draw_scene(seed, i) for i in range(n)]
+    scenes = draw_scenes(n, seed, drives)
     first = [s for s in schemes if s not in DEFERRED]
     second = [s for s in schemes if s in DEFERRED]
     done: dict[tuple[int, str], dict] = {}
@@ -319,7 +352,7 @@ def _parallel_study(n, seed, schemes, extra, max_wall, progress, on_failure, job
                     if stop:
                         results[i, scheme] = _skipped(scenes[i], i, scheme, stop, extra)
                     else:
-                        fut = pool.submit(_cell_task, seed, i, scheme, tuple(extra))
+                        fut = pool.submit(_cell_task, seed, i, scheme, tuple(extra), drives)
                         running[fut] = (i, scheme)
                     k_next += 1
                 if running and tasks[k_emit] not in results:
@@ -365,18 +398,23 @@ def counts(rows) -> dict:
     return {"status": dict(by_status), "reason": dict(by_reason)}
 
 
-def random_markdown(rows, seed: int, n: int, wall: float, extra=()) -> str:
-    """Counts per status and per scheme, refusals and failures by key, the failed cells."""
+def random_markdown(rows, seed: int, n: int, wall: float, extra=(), drives=False) -> str:
+    """Counts per status and per scheme, refusals and failures by key, the failed cells
+    (``drives``: of random closed drives)."""
     c = counts(rows)
     schemes = list(dict.fromkeys(r["scheme"] for r in rows))
     statuses = [s.value for s in CellStatus] + [CRASHED, SKIPPED]
     statuses = [s for s in statuses if s in c["status"]]
     grid = ", ".join(f"{k} = {v}" for k, v in extra) if extra else "the default grid"
-    relative = ", ".join(f"{k} {b:g}" for k, b in BOUNDS.items() if k != "slip_start")
-    lines = [f"# Random scenes: {n} drawn with seed {seed}, on {grid}", "",
+    if drives:
+        bounds = ", ".join(f"{k} {b:g}" for k, b in DRIVE_BOUNDS.items()) + " (relative)"
+    else:
+        bounds = (", ".join(f"{k} {b:g}" for k, b in BOUNDS.items() if k != "slip_start")
+                  + f" (relative), slip start {SLIP_START_ELEMENTS:g} L / N (N elements)")
+    lines = [f"# Random {'drives' if drives else 'scenes'}: {n} drawn with seed {seed}, on "
+             f"{grid}", "",
              (f"{len(rows)} cells in {wall:.0f} s wall; {sum(failed(r) for r in rows)} "
-              f"failed. Bounds: {relative} (relative), slip start "
-              f"{SLIP_START_ELEMENTS:g} L / N (N elements)."), "",
+              f"failed. Bounds: {bounds}."), "",
              "| scheme | " + " | ".join(statuses) + " |", "|---|" + "---|" * len(statuses)]
     for scheme in schemes + ["all"]:
         mine = Counter(r["status"] for r in rows if scheme in ("all", r["scheme"]))
@@ -423,7 +461,12 @@ def main(argv=None) -> int:
     parser.add_argument("--jobs", type=int, default=1, metavar="J",
                         help="run the cells in J processes (default 1); the rows and counts "
                              "are the same, only the wall times differ")
-    parser.add_argument("--out", default="runs/out/stability_random", help="output directory")
+    parser.add_argument("--drives", action="store_true",
+                        help="random closed drives (validation.random_drives) instead of "
+                             "straight belts")
+    parser.add_argument("--out", default=None,
+                        help="output directory (default runs/out/stability_random, "
+                             "runs/out/stability_random_drives with --drives)")
     args = parser.parse_args(argv)
     if args.n < 1:
         parser.error(f"N: must be >= 1 scene, got {args.n}")
@@ -431,7 +474,8 @@ def main(argv=None) -> int:
         parser.error(f"--max-wall: must be > 0 s, got {args.max_wall}")
     if args.jobs < 1:
         parser.error(f"--jobs: must be >= 1, got {args.jobs}")
-    out = prepare_outdir(Path(args.out))
+    out = prepare_outdir(Path(args.out or "runs/out/stability_random"
+                              + ("_drives" if args.drives else "")))
     failures = out / "failures"
     for old in failures.glob("scene_*.toml"):  # a previous draw's: they would pass as ours
         old.unlink()
@@ -448,11 +492,13 @@ def main(argv=None) -> int:
                      failure_scene(scene, rows, extra).to_toml())
     start = time.perf_counter()
     rows = random_study(args.n, args.seed, extra=extra, max_wall=args.max_wall,
-                        progress=show, on_failure=keep, jobs=args.jobs)
+                        progress=show, on_failure=keep, jobs=args.jobs, drives=args.drives)
     wall = time.perf_counter() - start
-    write_csv(out / "random.csv", COLUMNS, [[r[c] for r in rows] for c in COLUMNS],
+    cols = (*COLUMNS, *error_columns(rows), "reason")
+    write_csv(out / "random.csv", cols, [[r[c] for r in rows] for c in cols],
               text_columns=TEXT_COLUMNS)
-    write_atomic(out / "random.md", random_markdown(rows, args.seed, args.n, wall, extra))
+    write_atomic(out / "random.md", random_markdown(rows, args.seed, args.n, wall, extra,
+                                                    args.drives))
     tally = counts(rows)
     print(f"{args.n} scenes (seed {args.seed}), {len(rows)} cells in {wall:.0f} s: "
           + ", ".join(f"{k} {n}" for k, n in sorted(tally["status"].items())))

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from .api import is_drive_scene
 from .cli_text import cell as _cell
 from .cli_text import format_run, format_summary
 from .cli_text import int_list as _int_list
@@ -34,14 +35,9 @@ def _scene(args):
     return load_scene(args.scene, args.overrides)
 
 
-def _is_drive(scene) -> bool:
-    from .api import is_drive_scene
-    return is_drive_scene(scene)
-
-
 def _straight_only(args, scene):
     """Refuse, in one line, a closed drive in a command that knows only straight belts."""
-    if _is_drive(scene):
+    if is_drive_scene(scene):
         raise UsageError(f"{args.command}: not available for a closed drive yet (use "
                          f"'beltsim run' or 'beltsim analytic')")
     return scene
@@ -99,7 +95,7 @@ def cmd_analytic(args):
     from .problem import analytic
 
     scene = _scene(args)
-    if _is_drive(scene):
+    if is_drive_scene(scene):
         return _drive_analytic(args, scene)
     sol = analytic.solve(scene)
     out = _analytic_outdir(args)
@@ -215,15 +211,12 @@ def cmd_stability(args):
 
     from .io.files import prepare_outdir, write_atomic, write_csv
     from .studies import stability as studies
-    from .studies.convergence import ERROR_KEYS
 
     out = prepare_outdir(args.out or Path("runs/out/stability"))
     extra = [("numerics.elements", args.elements)] if args.elements else []
     cases = studies.STABILITY_CASES
     if args.elements:  # a coarse matrix: a case about the grid is the others coarsened
         cases = tuple(c for c in cases if not c.sets_grid)
-    cols = ("case", "scheme", "status", "dt", "steps", "wall_time") + tuple(
-        f"error_{k}" for k in ERROR_KEYS) + ("reason",)
 
     def show(row):
         print(f"{row['case']:<40s} {row['scheme']:<9s} {row['status'].value:<15s} "
@@ -231,8 +224,12 @@ def cmd_stability(args):
     # a coarse grid's own error would hide whether a scheme reached its grid's steady state
     rows = studies.stability_matrix(cases, extra=extra, progress=show,
                                     discrete=bool(args.elements))
+    # the errors of both layouts' cells, each empty (nan) where a cell has none
+    cols = ("case", "scheme", "status", "dt", "steps", "wall_time",
+            *studies.error_columns(rows), "reason")
     write_csv(out / "stability.csv", cols,
-              [[r[c].value if c == "status" else r[c] for r in rows] for c in cols],
+              [[r[c].value if c == "status" else r.get(c, float("nan")) for r in rows]
+               for c in cols],
               text_columns={"case", "scheme", "status", "reason"})
     write_atomic(out / "stability.md", studies.stability_markdown(rows))
     bad = [r for r in rows if r["status"] not in studies.ACCEPTED]
@@ -255,7 +252,7 @@ def cmd_sweep(args):
     key, values = sweep.parse_vary(args.vary, scene)
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers: must be >= 1, got {args.workers}")
-    if _is_drive(scene):
+    if is_drive_scene(scene):
         return _drive_sweep(args, scene, key, values)
     out = prepare_outdir(args.out or Path("runs/out") / f"sweep_{Path(args.scene).stem}")
     collapse = key == "contact.max_friction"
@@ -389,7 +386,7 @@ def cmd_animate(args):
 
         window = discretise(scene).window
         interval = args.interval or scene.numerics.get("snapshot_interval") or window / (
-            8 if _is_drive(scene) else 4)
+            8 if is_drive_scene(scene) else 4)
         if not interval > 0:
             raise UsageError(f"--interval: must be > 0 s, got {interval}")
         out = prepare_outdir(args.out or Path("runs/out") / f"animate_{Path(args.scene).stem}")
@@ -399,7 +396,7 @@ def cmd_animate(args):
         print(f"ran {args.scene}: {'steady' if result.converged else result.reason} at "
               f"t = {result.simulated_time:.4g} s, {len(result.snapshots['t'])} snapshots")
         src = out
-        if _is_drive(scene):
+        if is_drive_scene(scene):
             return _drive_animate(args, out, src)
     if not (src / SNAPSHOTS).is_file():
         raise UsageError(f"--from {src}: no {SNAPSHOTS} there (run with --snapshots INTERVAL)")
@@ -437,7 +434,7 @@ def cmd_scenes(args):
 
 def _scene_kind(scene) -> tuple[str, str]:
     """A shipped scene's kind (closed drive or straight belt, and its friction) and title."""
-    if _is_drive(scene):
+    if is_drive_scene(scene):
         return "closed drive", scene.title
     friction = {"stick": "perfect adhesion", "coulomb": "stick and slip"}
     return f"straight belt, {friction.get(scene.contact.friction, scene.contact.friction)}", \

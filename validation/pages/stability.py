@@ -11,6 +11,9 @@ from beltsim.studies.stability import (
     ACCEPTED,
     BOUNDS,
     DISCRETE_BOUNDS,
+    DRIVE_BOUNDS,
+    DRIVE_CASES,
+    DRIVE_DISCRETE_BOUNDS,
     STABILITY_CASES,
     CellStatus,
     stability_markdown,
@@ -23,8 +26,10 @@ from .kit import Page, num
 TITLE = "Stability matrix and random scenes"
 #: the coarse matrix of --quick: every case but those about the grid, on this grid
 QUICK_ELEMENTS = 60
-#: (scenes, seed, elements or None for each scene's default, max wall s) of the campaign
+#: (scenes, seed, elements or None for each scene's default, max wall s) of the campaign,
+#: of straight belts and of closed drives, by --quick
 RANDOM = {False: (40, 1, None, 900.0), True: (3, 1, None, 120.0)}
+RANDOM_DRIVES = {False: (20, 1, None, 900.0), True: (2, 1, 200, 120.0)}
 
 
 def _status(row) -> str:
@@ -41,9 +46,12 @@ def matrix_section(page: Page, quick: bool) -> None:
     page.heading("The stability matrix")
     page.para(
         f"`{command}`: {len(cases)} stiff and extreme scenes, each derived from a paper "
-        f"scene, by every registered scheme ({', '.join(solvers.names())}). A cell ends in "
+        f"scene or, the last {len(DRIVE_CASES)}, from the closed drive drive_flat, by "
+        f"every registered scheme ({', '.join(solvers.names())}). A cell ends in "
         f"one status: *converged* (steady, within the transient simulator's acceptance "
-        f"bounds, " + ", ".join(f"{k} {b:g}" for k, b in BOUNDS.items()) + "), *bounded* "
+        f"bounds, " + ", ".join(f"{k} {b:g}" for k, b in BOUNDS.items())
+        + "; a drive's, " + ", ".join(f"{k} {b:g}" for k, b in DRIVE_BOUNDS.items())
+        + "), *bounded* "
         "(a case run over a fixed span, or a stable but slowly settling one: finite and "
         "bounded throughout), *refused* (a rule of the scene or its numerics, before "
         "anything runs), *not applicable*, *unstable steady state* (the time-accurate run "
@@ -56,7 +64,9 @@ def matrix_section(page: Page, quick: bool) -> None:
             f"are set for each scene's default grid, so a coarse cell is judged against "
             f"the steady scheme's state on the same grid instead, within "
             + ", ".join(f"{k} {b:g}" for k, b in DISCRETE_BOUNDS.items())
-            + ": each scheme must reach its grid's steady state.")
+            + " (a drive's, " + ", ".join(f"{k} {b:g}" for k, b in
+                                          DRIVE_DISCRETE_BOUNDS.items())
+            + "): each scheme must reach its grid's steady state.")
     start = time.perf_counter()
     rows = stability_matrix(cases, extra=extra, discrete=quick)
     wall = time.perf_counter() - start
@@ -88,29 +98,40 @@ def matrix_section(page: Page, quick: bool) -> None:
     page.raw(stability_markdown(rows))
 
 
-def random_section(page: Page, quick: bool) -> None:
-    n, seed, elements, max_wall = RANDOM[quick]
+def random_section(page: Page, quick: bool, drives: bool = False) -> None:
+    n, seed, elements, max_wall = (RANDOM_DRIVES if drives else RANDOM)[quick]
     extra = [("numerics.elements", elements)] if elements else []
     command = (f"python -m validation.random_scenes {n} --seed {seed}"
+               + (" --drives" if drives else "")
                + (f" --elements {elements}" if elements else "")
                + f" --max-wall {num(max_wall)}")
-    page.heading("Random scenes")
-    page.para(
-        f"`{command}`: {n} valid scenes drawn across the whole parameter space (geometry, "
-        f"materials, speeds up to 0.95 of the lower critical speed, mismatch, friction, "
-        f"inertia and damping; scene i of seed S is always the same scene), each by every "
-        f"applicable scheme on its default grid, judged by the stability matrix's rules "
-        f"(the slip start's bound scaled to the grid). Cells not started within the wall "
-        f"budget are reported as skipped, not as passed.")
+    if drives:
+        page.heading("Random closed drives")
+        page.para(
+            f"`{command}`: {n} valid two-pulley drives drawn across their parameter space "
+            f"(radii, centre distance, belt, installation tension, speeds up to rho c^2 = "
+            f"0.5 N0, friction coefficient, a load of 0.1 to 0.9 of the capacity, the driven "
+            f"pulley's inertia, the beam and the string, inertial and quasistatic; "
+            f"validation/random_drives.py), each from rest by every applicable scheme, "
+            f"judged by the stability matrix's rules.")
+    else:
+        page.heading("Random scenes")
+        page.para(
+            f"`{command}`: {n} valid scenes drawn across the whole parameter space "
+            f"(geometry, materials, speeds up to 0.95 of the lower critical speed, "
+            f"mismatch, friction, inertia and damping; scene i of seed S is always the same "
+            f"scene), each by every applicable scheme on its default grid, judged by the "
+            f"stability matrix's rules (the slip start's bound scaled to the grid). Cells "
+            f"not started within the wall budget are reported as skipped, not as passed.")
     start = time.perf_counter()
-    rows = random_study(n, seed, extra=extra, max_wall=max_wall)
+    rows = random_study(n, seed, extra=extra, max_wall=max_wall, drives=drives)
     wall = time.perf_counter() - start
     for r in rows:
         if failed(r):
-            page.fail(f"random scene {r['index']} (seed {seed}), {r['scheme']}: "
-                      f"{r['status']} ({r['reason']})")
+            page.fail(f"random {'drive' if drives else 'scene'} {r['index']} (seed {seed}), "
+                      f"{r['scheme']}: {r['status']} ({r['reason']})")
     skipped = sum(r["status"] == SKIPPED for r in rows)
-    text = random_markdown(rows, seed, n, wall, extra)
+    text = random_markdown(rows, seed, n, wall, extra, drives)
     # its title becomes a subsection of this page
     lines = text.splitlines()
     if lines and lines[0].startswith("# "):
@@ -129,3 +150,4 @@ def build(page: Page, quick: bool) -> None:
         "does not deliver.")
     matrix_section(page, quick)
     random_section(page, quick)
+    random_section(page, quick, drives=True)

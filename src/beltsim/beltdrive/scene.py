@@ -103,6 +103,7 @@ SCHEMA: dict[str, dict[str, Rule]] = {
         "newton_max_iterations": Rule("int", minimum=1),
         "snapshot_interval": POS,
         "gyroscopic": Rule("str", choices=("upwind", "central")),
+        "acceleration": Rule("float", nonneg=True),
     },
 }
 REQUIRED = {"belt": ("height", "width", "youngs_modulus", "poisson_ratio", "shear_factor"),

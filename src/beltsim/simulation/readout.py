@@ -14,7 +14,7 @@ from ..errors import NoSolutionError
 from ..problem.drive import mismatch as mismatch_at
 from .loop_solution import HISTORY_KEYS, LoopSolution
 from .result import RunStatus, reference_of
-from .solution import DiscreteSolution
+from .solution import DiscreteReference, DiscreteSolution
 
 #: checks in a row with a whole wrap sliding and the driven pulley slowing: gross slip
 GROSS_SLIP_CHECKS = 3
@@ -26,6 +26,8 @@ class Readout:
 
     #: what snapshots store of the state (arrays over the nodes)
     snapshot_keys = ("u", "theta", "fnode")
+    #: the errors a study reports, of :meth:`RunResult.errors` (relative; slip start in m)
+    error_keys = ("total_friction", "u", "theta", "concentrated_force", "slip_start")
 
     def __init__(self, disc):
         self.disc = disc
@@ -69,6 +71,12 @@ class Readout:
         """The exact steady solution of the scene, or None."""
         return reference_of(self.disc.scene)
 
+    @staticmethod
+    def discrete_reference(solution):
+        """A discrete steady state of this layout as the reference of another state on the
+        same grid."""
+        return DiscreteReference(solution)
+
 
 class LoopReadout(Readout):
     """A closed drive's: the driver's torque, the span tensions, the speeds and slip arcs,
@@ -76,6 +84,8 @@ class LoopReadout(Readout):
     gross slip end a run as outcomes."""
 
     snapshot_keys = ("u", "theta", "fnode", "lam", "g")
+    error_keys = ("tight_tension", "slack_tension", "speed_loss", "slip_arc_driver",
+                  "slip_arc_driven")
 
     def __init__(self, disc):
         self.disc = disc
@@ -137,6 +147,18 @@ class LoopReadout(Readout):
             return None
 
 
+    @staticmethod
+    def discrete_reference(solution):
+        """A drive's discrete steady state: its own summary is what another's errors
+        compare with (:meth:`LoopSolution.errors`)."""
+        return solution
+
+
+def readout_class(closed: bool) -> type[Readout]:
+    """The readout of the open layout or of a loop (``closed``)."""
+    return LoopReadout if closed else Readout
+
+
 def readout_of(disc) -> Readout:
     """The readout of a discretisation's layout."""
-    return LoopReadout(disc) if disc.closed else Readout(disc)
+    return readout_class(disc.closed)(disc)

@@ -42,6 +42,11 @@ ROUNDOFF_FLOOR = 1e3
 CONTRACTION = 0.5
 # A scaled residual of root mean square below 1e-13 per row is at round-off
 ROUNDOFF_MERIT = 1e-26
+# full semi-smooth Newton steps before a step whose stick/slip pattern still changes is
+# damped (a cycle between patterns, each one's full step landing in the other), and the
+# most halvings of such a step
+CYCLE_ITERATIONS = 8
+MAX_HALVINGS = 8
 # A friction ratio with slope dlam/ds below NEAR_BOUND (|lam| > 0.995 for tanh) that
 # differs from the law at its slip velocity by more than LAW_GAP is stuck at the bound
 NEAR_BOUND = 1e-2
@@ -419,7 +424,6 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
     st = w.stats[0]
     tol = settings.tol
     n = w.R.shape[0]
-    off = mesh.off
     ng = g.shape[0]
     fs = p.friction_scale * friction_factor(drive, t)
     for j in range(s.active.shape[0]):
@@ -439,16 +443,23 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
         if not (np.isfinite(step) and np.isfinite(dlam)):
             st.merit = merit(w.R, w.Rg, scales)
             return False
-        for i in range(n):
-            u[i + off] += s.dx[i, 0]
-            th[i + off] += s.dx[i, 1]
-        for k in range(ng):
-            g[k] += s.dg[k]
-        for j in mesh.cn:
-            lam[j] += s.dx[j - off, 2]
+        damped = it >= CYCLE_ITERATIONS
+        m_before = saddle_merit(s, scales) if damped else 0.0
+        alpha = 1.0
+        shift_saddle(state, s, mesh, alpha)
         assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
         changed = saddle_system(lam, loop_speed(g, mesh, p), inv_dt, fs, mesh, p, w, s)
-        update = max(step, dlam)
+        # past CYCLE_ITERATIONS a pattern that still changes is cycling: the step is
+        # halved until the whole residual (the friction rows' too) decreases
+        for _ in range(MAX_HALVINGS if damped and changed > 0 else 0):
+            if saddle_merit(s, scales) < m_before:
+                break
+            alpha *= 0.5
+            shift_saddle(state, s, mesh, -alpha)
+            st.line_search_cuts += 1
+            assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+            changed = saddle_system(lam, loop_speed(g, mesh, p), inv_dt, fs, mesh, p, w, s)
+        update = alpha * max(step, dlam)
         # a front node may flip between stick and slip at round-off: a residual at its
         # floor ends the iteration whatever the pattern did
         settled = changed == 0 or merit(w.R, w.Rg, scales) < ROUNDOFF_MERIT * (n + ng)
@@ -461,6 +472,30 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
             return factorise(w, mesh)
     st.merit = merit(w.R, w.Rg, scales)
     return False
+
+
+@njit(cache=True)
+def shift_saddle(state, s, mesh, alpha):
+    """(u, theta, the friction ratios, the globals) += alpha times the semi-smooth
+    Newton update in s."""
+    off = mesh.off
+    for i in range(s.dx.shape[0]):
+        state.u[i + off] += alpha * s.dx[i, 0]
+        state.theta[i + off] += alpha * s.dx[i, 1]
+    for k in range(state.g.shape[0]):
+        state.g[k] += alpha * s.dg[k]
+    for j in mesh.cn:
+        state.lam[j] += alpha * s.dx[j - off, 2]
+
+
+@njit(cache=True)
+def saddle_merit(s, scales):
+    """The squared norm of the semi-smooth system's residual: :func:`merit` of its force,
+    moment and global rows, plus its friction rows (ratios, already dimensionless)."""
+    m = merit(s.R, s.Rg, scales)
+    for i in range(s.R.shape[0]):
+        m += s.R[i, 2] * s.R[i, 2]
+    return m
 
 
 class NewtonScheme(Scheme):

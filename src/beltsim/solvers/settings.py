@@ -28,7 +28,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import SceneError
-from ..physics.friction import AUGMENTATION, LAW_CODES
+from ..physics.friction import AUGMENTATION, LAW_CODES, is_exact
 from ..physics.grid import Grid, make_grid
 from ..physics.model import GYROSCOPIC_FORMS
 from ..problem import analytic
@@ -50,6 +50,12 @@ ELEMENTS_PER_LAYER = 10.0
 DEFAULT_INTEGRATOR = "esdirk3"
 TIME_TOLS = {"esdirk3": 2e-5, "implicit": 6e-6}
 DEFAULT_TIME_TOL = TIME_TOLS[DEFAULT_INTEGRATOR]
+#: Newton iterations of a step before it is cut, by friction law: the exact laws' semi-smooth
+#: iteration damps a cycling stick/slip pattern (solvers.newton.CYCLE_ITERATIONS) and needs
+#: more (a quasistatic string drive's start-up: 60 left steps that cycle at every size,
+#: 100 converged)
+NEWTON_ITERATIONS = 30
+EXACT_NEWTON_ITERATIONS = 100
 #: the first step of an adaptive scheme (the fixed step of the pseudo-transient one): this
 #: fraction of the ramp time or the transit time, whichever is longer
 FIRST_STEPS = 50.0
@@ -82,7 +88,7 @@ class Numerics:
     steady_tol: float
     snapshot_interval: float | None
     newton_tol: float = 1e-9
-    newton_max_iterations: int = 30
+    newton_max_iterations: int = NEWTON_ITERATIONS
     time_tol: float = DEFAULT_TIME_TOL
     max_work: float = DEFAULT_MAX_WORK
     settle_time: float = 0.0  # when the drive stops changing (steady tests start there)
@@ -152,8 +158,8 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         delta = nm.get("adhesion_layer", DEFAULT_ADHESION_LAYER * P.L * refine)
         law, regularisation = "linear", 1.0
         friction_scale = P.B / (P.c * delta)
-    acceleration = acceleration_of(nm, integrator, P.inertia,
-                                   math.pi * P.B / (P.L * math.sqrt(P.rho * P.b1)))
+    acceleration = acceleration_of(nm, integrator, P.inertia, math.pi * P.B / (
+        P.L * math.sqrt(P.rho * P.b1)) if P.inertia else 0.0)
     gyroscopic = nm.get("gyroscopic", "upwind")
     if "max_work" in nm and integrator != "explicit":
         raise SceneError("numerics.max_work", 'only for numerics.integrator = "explicit" (the '
@@ -168,7 +174,7 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         acceleration=acceleration, steady_tol=nm.get("steady_tol", 1e-6),
         snapshot_interval=nm.get("snapshot_interval"),
         newton_tol=nm.get("newton_tol", 1e-9),
-        newton_max_iterations=nm.get("newton_max_iterations", 30),
+        newton_max_iterations=newton_iterations(nm, law),
         time_tol=nm.get("time_tol", TIME_TOLS.get(integrator, DEFAULT_TIME_TOL)),
         settle_time=settle_time(scene, ramp_time),
         max_work=nm.get("max_work", DEFAULT_MAX_WORK),
@@ -187,6 +193,12 @@ def acceleration_of(nm: dict, integrator: str, inertia: bool, omega1: float) -> 
         raise SceneError("numerics.acceleration", f"only for numerics.integrator = {allowed} "
                          f"(the damping of a time-accurate run is physics.damping)")
     return nm.get("acceleration", 2.0 * omega1) if accelerated and inertia else 0.0
+
+
+def newton_iterations(nm: dict, law: str) -> int:
+    """numerics.newton_max_iterations with its default for the friction law ``law``."""
+    return nm.get("newton_max_iterations", EXACT_NEWTON_ITERATIONS
+                  if is_exact(LAW_CODES[law]) else NEWTON_ITERATIONS)
 
 
 def available_memory() -> float | None:
@@ -298,6 +310,6 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
         steady_tol=nm.get("steady_tol", 1e-7),
         snapshot_interval=nm.get("snapshot_interval"),
         newton_tol=nm.get("newton_tol", 1e-9),
-        newton_max_iterations=nm.get("newton_max_iterations", 30),
+        newton_max_iterations=newton_iterations(nm, law),
         time_tol=nm.get("time_tol", LOOP_TIME_TOLS.get(integrator, DEFAULT_TIME_TOL)),
         settle_time=settle, gyroscopic=nm.get("gyroscopic", "upwind"))

@@ -13,11 +13,12 @@ from ..errors import SceneError
 from ..physics.grid import bisect
 from ..problem.scene import Scene
 from ..simulation.controller import Simulation
+from ..simulation.readout import Readout
 from ..simulation.result import reference_of
 from ..simulation.solution import DiscreteSolution, compare, relative_error
 
 LADDER = (125, 250, 500, 1000, 2000)
-ERROR_KEYS = ("total_friction", "u", "theta", "concentrated_force", "slip_start")
+ERROR_KEYS = Readout.error_keys  # the open layout's
 RICHARDSON = "richardson"  # the extrapolated steady scheme, a study rather than a scheme
 
 

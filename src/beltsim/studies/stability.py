@@ -16,13 +16,12 @@ import math
 from dataclasses import dataclass
 
 from .. import solvers
-from ..api import shipped_scene
+from ..api import is_drive_scene, shipped_scene
 from ..errors import BeltsimError, SceneError
 from ..problem.scene import Scene
 from ..simulation.controller import Simulation
-from ..simulation.result import RunStatus, reference_of
-from ..simulation.solution import DiscreteReference
-from .convergence import ERROR_KEYS
+from ..simulation.readout import readout_class
+from ..simulation.result import RunStatus
 
 #: Bounds of a coarse matrix, against the steady scheme's state on the same grid: each
 #: scheme must reach its grid's steady state to within these, about ten times the largest
@@ -33,6 +32,16 @@ DISCRETE_BOUNDS = {"total_friction": 3e-6, "u": 3e-5, "theta": 3e-5,
 #: The acceptance bounds of the transient simulator (relative errors; slip start in m).
 BOUNDS = {"total_friction": 5e-3, "u": 2e-2, "theta": 2e-2, "concentrated_force": 5e-2,
           "slip_start": 5e-3}
+
+
+#: A closed drive's bounds, against the steady scheme's state on the same grid (measured on
+#: drive_flat's 200 elements: every scheme within 3e-14; the steady test stops at a change
+#: of 1e-7 per transit) and against the exact steady state (the default grid's errors:
+#: tensions 1e-6, speed loss 1e-6 of itself, slip arcs 1.5e-3 of the wrap)
+DRIVE_DISCRETE_BOUNDS = {"tight_tension": 1e-6, "slack_tension": 1e-6, "speed_loss": 1e-5,
+                         "slip_arc_driver": 1e-5, "slip_arc_driven": 1e-5}
+DRIVE_BOUNDS = {"tight_tension": 1e-4, "slack_tension": 1e-4, "speed_loss": 1e-3,
+                "slip_arc_driver": 1e-2, "slip_arc_driven": 1e-2}
 
 
 class CellStatus(enum.StrEnum):
@@ -80,14 +89,35 @@ class Case:
         """Whether the case is about the grid itself (a coarse matrix leaves it out)."""
         return any(key == "numerics.elements" for key, _ in self.overrides)
 
+    def base_scene(self):
+        """The base scene (a straight belt or a drive); MissingInputError when a shipped
+        base is not installed."""
+        return shipped_scene(self.base) if isinstance(self.base, str) else self.base
+
     def scene(self, extra=()) -> Scene:
         """The case's scene with ``extra`` (key, value) overrides; raises SceneError when
         they break a rule, MissingInputError when a shipped base is not installed."""
-        base = shipped_scene(self.base) if isinstance(self.base, str) else self.base
         span = [("numerics.t_end", self.span)] if self.span else []
-        return base.with_overrides([*self.overrides, *span, *extra])
+        return self.base_scene().with_overrides([*self.overrides, *span, *extra])
 
 
+#: The closed drive's cases, each derived from drive_flat (R = 80 / 160 mm, 12 m/s, 50 N m
+#: of its capacity 98.4 N m)
+DRIVE_CASES = (
+    Case("drive: flat belt", "drive_flat"),
+    Case("drive: regularised law (tanh)", "drive_flat", (("numerics.friction_law", "tanh"),)),
+    Case("drive: string model", "drive_flat", (("physics.model", "string"),)),
+    Case("drive: quasistatic string", "drive_flat",
+         (("physics.model", "string"), ("physics.inertia", False))),
+    Case("drive: stiff belt (E x 100)", "drive_flat", (("belt.youngs_modulus", 5.0e10),)),
+    Case("drive: fast belt (38 m/s, rho c^2 = 0.42 N0)", "drive_flat",
+         (("drive.driver_speed", 475.0), ("drive.installation_tension", 1000.0))),
+    Case("drive: light driven pulley (J2 / 100)", "drive_flat",
+         (("drive.driven_inertia", 2.0e-4),)),
+    Case("drive: heavy driven pulley (J2 x 50)", "drive_flat", (("drive.driven_inertia", 1.0),)),
+    Case("drive: load at 0.95 of the capacity", "drive_flat", (("drive.load_torque", 93.5),)),
+    Case("drive: undamped belt", "drive_flat", (("physics.damping", 0.0),)),
+)
 _THIN = (("beam.height", 0.01),)
 _OUTLET = (("contact.start", 0.6466666666666666), ("contact.end", 0.98))
 #: Each derived from the paper's data.
@@ -131,6 +161,7 @@ STABILITY_CASES = (
          (("contact.start", 0.02), ("contact.end", 0.3533333333333333))),
     Case("paper slip, undamped", "paper_slip", (("physics.damping", 0.0),), span=0.1),
     Case("paper inertia, undamped", "paper_inertia", (("physics.damping", 0.0),), span=0.1),
+    *DRIVE_CASES,
 )
 
 
@@ -146,15 +177,17 @@ def stability_cell(case: Case, scheme: str, extra=(), bounds=None, discrete=Fals
     A shipped base scene that is not installed raises MissingInputError: a missing input
     fails the study, it is never a refused cell.
     """
+    closed = is_drive_scene(case.base_scene())
+    keys = readout_class(closed).error_keys
     cell = {"scheme": scheme, "status": "", "reason": "", "reason_key": "",
             "dt": float("nan"), "steps": 0, "wall_time": float("nan"),
-            **{f"error_{k}": float("nan") for k in ERROR_KEYS}}
+            **{f"error_{k}": float("nan") for k in keys}}
     try:
         scene = case.scene(extra)
     except SceneError as exc:
         cell.update(status=CellStatus.REFUSED, reason=str(exc), reason_key=exc.key or "")
         return cell
-    why_not = solvers.applicable(scheme, scene.params.inertia)
+    why_not = solvers.applicable(scheme, scene.params.inertia, closed)
     if why_not:
         cell.update(status=CellStatus.NOT_APPLICABLE, reason=why_not)
         return cell
@@ -167,12 +200,14 @@ def stability_cell(case: Case, scheme: str, extra=(), bounds=None, discrete=Fals
     res = sim.run(raise_on_failure=False)
     own_grid = _discrete_reference(scene) if discrete else None
     if own_grid is not None:
-        bounds = DISCRETE_BOUNDS
-    res.reference = own_grid if own_grid is not None else reference_of(scene)
+        bounds = DRIVE_DISCRETE_BOUNDS if closed else DISCRETE_BOUNDS
+    elif bounds is None:
+        bounds = DRIVE_BOUNDS if closed else BOUNDS
+    res.reference = own_grid if own_grid is not None else sim.readout.reference()
     err = res.errors() or {}
     cell.update(dt=sim.numerics.dt if sim.scheme.transient else float("nan"),
                 steps=res.steps, wall_time=res.wall_time,
-                **{f"error_{k}": err[k] for k in ERROR_KEYS if err.get(k) is not None})
+                **{f"error_{k}": err[k] for k in keys if err.get(k) is not None})
     if (case.span and sim.scheme.transient
             and res.status in (RunStatus.REACHED_END, RunStatus.CONVERGED)):
         cell.update(status=CellStatus.BOUNDED,
@@ -183,7 +218,8 @@ def stability_cell(case: Case, scheme: str, extra=(), bounds=None, discrete=Fals
         cell.update(status=_RUN_STATUS[res.status], reason=res.reason,
                     reason_key=(res.failure or res.status).value)
         diverged = res.failure is not None and res.failure.diverged
-        if (sim.scheme.time_accurate and scene.params.inertia
+        # (a loop has no linearisation yet: its cells keep the run's status)
+        if (sim.scheme.time_accurate and scene.params.inertia and not closed
                 and (diverged or res.status is RunStatus.REACHED_END)):
             unstable, why, decay = steady_state_stability(scene)
             cell.update(status=CellStatus.UNSTABLE if unstable else cell["status"],
@@ -202,7 +238,7 @@ def stability_cell(case: Case, scheme: str, extra=(), bounds=None, discrete=Fals
                     f"more than t_end leaves ({span:.3g} s); raise "
                     f"numerics.t_end; {cell['reason']}"))
     else:
-        over = {k: b for k, b in (bounds or BOUNDS).items()
+        over = {k: b for k, b in bounds.items()
                 if err.get(k) is not None and not err[k] <= b}
         cell.update(status=CellStatus.OUT_OF_BOUNDS if over else CellStatus.CONVERGED,
                     reason="; ".join(f"{k} {err[k]:.3g} > {b:g}" for k, b in over.items()),
@@ -224,13 +260,13 @@ def _discrete_reference(scene):
     """The steady scheme's state of ``scene`` on its own grid, or None where it fails."""
     key = _steady_key(scene)
     if key not in _STEADY:
-        res = Simulation(scene.with_overrides([("numerics.integrator", "steady")])).run(
-            raise_on_failure=False)
-        _STEADY[key] = DiscreteReference(res.solution) if res.converged else None
+        sim = Simulation(scene.with_overrides([("numerics.integrator", "steady")]))
+        res = sim.run(raise_on_failure=False)
+        _STEADY[key] = sim.readout.discrete_reference(res.solution) if res.converged else None
     return _STEADY[key]
 
 
-_STEADY: dict[tuple, DiscreteReference | None] = {}  # one steady solve per case
+_STEADY: dict[tuple, object] = {}  # one steady solve per case
 
 
 def steady_state_stability(scene) -> tuple[bool, str, float]:
@@ -288,18 +324,34 @@ def stability_matrix(cases=STABILITY_CASES, schemes=None, extra=(), progress=Non
     return rows
 
 
-def stability_markdown(rows) -> str:
-    """A table per case and scheme: status, dt, steps, wall time, errors, reason."""
-    head = ("| case | scheme | status | dt [s] | steps | wall [s] | total friction | u | theta "
-            "| conc. force | slip start [m] | reason |")
-    lines = [head, "|" + "---|" * 12]
+def error_columns(rows) -> list[str]:
+    """The ``error_*`` columns of the rows, in their first appearance's order (a straight
+    belt's and a drive's cells report different errors)."""
+    return list(dict.fromkeys(k for r in rows for k in r if k.startswith("error_")))
 
+
+_LABELS = {"total_friction": "total friction", "concentrated_force": "conc. force",
+           "slip_start": "slip start [m]"}
+
+
+def stability_markdown(rows) -> str:
+    """A table per layout (its errors' columns): case, scheme, status, dt, steps, wall
+    time, errors, reason."""
     def num(v, fmt):
         return "" if v is None or (isinstance(v, float) and not math.isfinite(v)) else fmt % v
+
+    groups: dict[tuple, list] = {}
     for r in rows:
-        lines.append("| " + " | ".join([
-            r["case"], r["scheme"], r["status"].value, num(r["dt"], "%.2e"), str(r["steps"]),
-            num(r["wall_time"], "%.3g"),
-            *(num(r[f"error_{k}"], "%.1e") for k in ERROR_KEYS),
-            r["reason"].replace("|", "/")]) + " |")
-    return "\n".join(lines) + "\n"
+        groups.setdefault(tuple(error_columns([r])), []).append(r)
+    tables = []
+    for cols, group in groups.items():
+        labels = [_LABELS.get(c[6:], c[6:].replace("_", " ")) for c in cols]
+        lines = ["| case | scheme | status | dt [s] | steps | wall [s] | " + " | ".join(labels)
+                 + " | reason |", "|" + "---|" * (7 + len(cols))]
+        for r in group:
+            lines.append("| " + " | ".join([
+                r["case"], r["scheme"], r["status"].value, num(r["dt"], "%.2e"),
+                str(r["steps"]), num(r["wall_time"], "%.3g"),
+                *(num(r[c], "%.1e") for c in cols), r["reason"].replace("|", "/")]) + " |")
+        tables.append("\n".join(lines) + "\n")
+    return "\n".join(tables)
