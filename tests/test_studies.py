@@ -242,6 +242,7 @@ def test_a_discrete_reference_measures_states_on_its_own_grid():
         ref.fields(sol.x[:-1])
 
 
+@pytest.mark.verification
 @pytest.mark.parametrize("case", [stability.STABILITY_CASES[2], stability.DRIVE_CASES[0]],
                          ids=["paper slip", "drive"])
 def test_a_coarse_cell_reaches_its_grids_steady_state_on_either_layout(case):

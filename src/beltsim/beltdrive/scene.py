@@ -19,7 +19,6 @@ Validation happens in :func:`validate`; every rule raises a one-line
 
 from __future__ import annotations
 
-import copy
 import math
 
 from ..errors import NoSolutionError, SceneError
@@ -36,7 +35,7 @@ from ..problem.rules import (
     set_scene_key,
     show,
 )
-from ..problem.tomlio import assignments, parse_toml, read_scene_file, toml_value
+from ..problem.tables import SceneTables
 from .analytic import LiftOffError, solve_string
 from .geometry import Geometry, GeometryError
 from .params import DriveParams, params_of
@@ -216,126 +215,29 @@ def max_rim_speed(data: dict) -> float:
     return profile_extremes(data["drive"]["driver_speed"])[1] * data["drive"]["driver_radius"]
 
 
-class DriveScene:
-    """A validated closed-drive scene.
-
-    Build it from a file (:meth:`load`), TOML text (:meth:`loads`) or nested tables
-    (:meth:`from_dict`); derive others with :meth:`with_overrides`.
+class DriveScene(SceneTables):
+    """A validated closed-drive scene (:class:`~beltsim.problem.tables.SceneTables`:
+    read, written and derived as a straight belt's scene is).
 
     Raises
     ------
     SceneError
         On the first broken rule, naming the key and the rule.
+
+    Examples
+    --------
+    >>> heavier = scene.replace(drive=scene.drive | {"load_torque": 40.0})  # doctest: +SKIP
     """
 
+    SCHEMA = SCHEMA
+    OPTIONAL = OPTIONAL_SECTIONS
+    KIND = "a drive scene"
+    validate = staticmethod(validate)
+    set_key = staticmethod(set_key)
+
     def __init__(self, data: dict, source: str | None = None):
-        self._data = validate(data)
-        self.source = source
+        super().__init__(data, source)
         self.params = params_of(self._data)
-
-    @classmethod
-    def load(cls, path) -> DriveScene:
-        """Read and validate a drive scene file (TOML)."""
-        return cls.loads(read_scene_file(path), source=str(path))
-
-    @classmethod
-    def loads(cls, text: str, source: str | None = None) -> DriveScene:
-        """Parse and validate a drive scene from TOML text."""
-        return cls(parse_toml(text, source), source=source)
-
-    @classmethod
-    def from_dict(cls, data: dict) -> DriveScene:
-        """A drive scene from nested tables (the scene keeps a copy)."""
-        return cls(copy.deepcopy(data))
-
-    def to_dict(self) -> dict:
-        """The scene's tables (a copy)."""
-        return copy.deepcopy(self._data)
-
-    def to_toml(self) -> str:
-        """The scene as TOML text, which :meth:`loads` reads back to an equal scene."""
-        lines = []
-        if "title" in self._data:
-            lines.append(f"title = {toml_value(self._data['title'])}")
-        for section in SCHEMA:
-            if section in self._data and self._data[section]:
-                lines.append(f"\n[{section}]")
-                lines += [f"{k} = {toml_value(v)}" for k, v in self._data[section].items()]
-        return "\n".join(lines) + "\n"
-
-    def with_overrides(self, overrides) -> DriveScene:
-        """This scene with some keys set, validated again.
-
-        Parameters
-        ----------
-        overrides : dict, str or iterable of str or (str, value)
-            ``{"drive.load_torque": 40.0}``, one ``"drive.load_torque=40"`` string (as
-            ``--set`` takes it), or an iterable of such strings or (key, value) pairs.
-
-        Returns
-        -------
-        DriveScene
-            A new scene; this one is unchanged.
-
-        Raises
-        ------
-        SceneError
-            An unknown section or key, an unparsable value, or a broken rule.
-        """
-        data = self.to_dict()
-        for key, value in assignments(overrides):
-            set_key(data, key, value)
-        return DriveScene(data, source=self.source)
-
-    def replace(self, **changes) -> DriveScene:
-        """This scene with some sections (or the title) replaced, validated again.
-
-        A section given as None is removed (the optional ``stiffness`` and ``numerics``,
-        and ``title``).
-
-        Parameters
-        ----------
-        **changes : dict, str or None
-            ``belt=``, ``stiffness=``, ``drive=``, ``contact=``, ``physics=``,
-            ``numerics=`` (the section's table as a dict) and ``title=``.
-
-        Returns
-        -------
-        DriveScene
-            A new scene; this one is unchanged.
-
-        Raises
-        ------
-        SceneError
-            An unknown section, a section that is not a table, or a broken rule.
-
-        Examples
-        --------
-        >>> heavier = scene.replace(drive=scene.drive | {"load_torque": 40.0})  # doctest: +SKIP
-        """
-        data = self.to_dict()
-        for name, value in changes.items():
-            if name == "title":
-                if value is None:
-                    data.pop("title", None)
-                else:
-                    data["title"] = value
-                continue
-            if name not in SCHEMA:
-                known = ", ".join([*SCHEMA, "title"])
-                raise SceneError(f"{name}: unknown section of a drive scene (known: {known})")
-            if value is None or (value == {} and name in OPTIONAL_SECTIONS):
-                data.pop(name, None)
-            elif isinstance(value, dict):
-                data[name] = copy.deepcopy(value)
-            else:
-                raise SceneError(f"[{name}]", f"must be a table (a dict), got {show(value)}")
-        return DriveScene(data, source=self.source)
-
-    @property
-    def title(self) -> str:
-        """The scene's title ("" if none)."""
-        return self._data.get("title", "")
 
     @property
     def numerics(self) -> dict:
@@ -346,12 +248,3 @@ class DriveScene:
     def drive(self) -> dict:
         """The ``[drive]`` table."""
         return dict(self._data["drive"])
-
-    def __eq__(self, other):
-        return isinstance(other, DriveScene) and self._data == other._data
-
-    def __hash__(self):
-        return hash(self.to_toml())
-
-    def __repr__(self):
-        return f"DriveScene({self.title or self.source or 'untitled'!r})"

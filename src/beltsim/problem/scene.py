@@ -26,7 +26,8 @@ from .builder import (
 )
 from .rules import check_table, final_value, profile_extremes, show
 from .shipped import scene_names
-from .tomlio import assignments, parse_assignment, parse_toml, read_scene_file, toml_value
+from .tables import SceneTables
+from .tomlio import parse_assignment, parse_toml, read_scene_file
 from .validation import (
     MIN_ELEMENTS,
     OPTIONAL_SECTIONS,
@@ -61,7 +62,7 @@ class _SectionOf(Generic[S]):
         return self.cls(**scene._data.get(self.cls.section, {}))
 
 
-class Scene:
+class Scene(SceneTables):
     """A validated scene: the contents of one scene file.
 
     Build it from a file (:meth:`load`), TOML text (:meth:`loads`), a nested dictionary
@@ -90,72 +91,14 @@ class Scene:
     100000.0
     """
 
-    def __init__(self, data: dict, source: str | None = None):
-        self._data = validate(data)
-        self.source = source
+    SCHEMA = SCHEMA
+    OPTIONAL = OPTIONAL_SECTIONS
+    validate = staticmethod(validate)
+    set_key = staticmethod(set_key)
 
-    # construction -----------------------------------------------------
-    @classmethod
-    def load(cls, path) -> Scene:
-        """Read and validate a scene file (TOML).
-
-        Parameters
-        ----------
-        path : str or Path
-            The scene file.
-
-        Returns
-        -------
-        Scene
-
-        Raises
-        ------
-        SceneError
-            The file is missing or unreadable, not TOML, or breaks a rule.
-        """
-        return cls.loads(read_scene_file(path), source=str(path))
-
-    @classmethod
-    def loads(cls, text: str, source: str | None = None) -> Scene:
-        """Parse and validate a scene from TOML text.
-
-        Parameters
-        ----------
-        text : str
-            A scene file's contents, e.g. what :meth:`to_toml` wrote.
-        source : str, optional
-            Where the text came from, for messages.
-
-        Returns
-        -------
-        Scene
-
-        Raises
-        ------
-        SceneError
-            Malformed TOML or a broken rule.
-        """
-        return cls(parse_toml(text, source), source=source)
-
-    @classmethod
-    def from_dict(cls, data: dict) -> Scene:
-        """A scene from nested tables (left unchanged: the scene keeps a copy).
-
-        Parameters
-        ----------
-        data : dict
-            ``{"beam": {...}, "motion": {...}, ...}`` as a scene file's tables.
-
-        Returns
-        -------
-        Scene
-
-        Raises
-        ------
-        SceneError
-            On the first broken rule.
-        """
-        return cls(copy.deepcopy(data))
+    def section_table(self, name: str, value):
+        """A section for :meth:`replace`: its typed class or its table (:func:`_table`)."""
+        return _table(name, value)
 
     @classmethod
     def build(cls, beam: Beam, motion: Motion, contact: Contact, physics: Physics,
@@ -208,99 +151,6 @@ class Scene:
                 data[name] = table
         return cls(data)
 
-    def replace(self, **changes) -> Scene:
-        """This scene with some sections (or the title) replaced, validated again.
-
-        ``dataclasses.replace`` changes a key of a section; this puts the new section
-        into a new scene. A section given as None is removed (the optional ``stiffness``
-        and ``numerics``, and ``title``).
-
-        Parameters
-        ----------
-        **changes : Section, dict, str or None
-            ``beam=``, ``motion=``, ``contact=``, ``physics=``, ``stiffness=``,
-            ``numerics=`` (a section of that class, or its table as a dict) and
-            ``title=``.
-
-        Returns
-        -------
-        Scene
-            A new scene; this one is unchanged.
-
-        Raises
-        ------
-        SceneError
-            An unknown section, a section of the wrong class, or a broken rule.
-
-        Examples
-        --------
-        >>> import dataclasses
-        >>> faster = scene.replace(                                     # doctest: +SKIP
-        ...     motion=dataclasses.replace(scene.motion, surface_speed=121.8))
-        """
-        data = self.to_dict()
-        for name, value in changes.items():
-            if name == "title":
-                if value is None:
-                    data.pop("title", None)
-                else:
-                    data["title"] = value
-                continue
-            if name not in SCHEMA:
-                known = ", ".join([*SCHEMA, *TOP_LEVEL_KEYS])
-                raise SceneError(f"{name}: unknown section (known: {known})")
-            table = _table(name, value)
-            if table is None:
-                data.pop(name, None)
-            else:
-                data[name] = table
-        return Scene(data, source=self.source)
-
-    def to_dict(self) -> dict:
-        """The scene as nested tables (a copy), as :meth:`from_dict` takes them.
-
-        Returns
-        -------
-        dict
-        """
-        return copy.deepcopy(self._data)
-
-    def with_overrides(self, overrides) -> Scene:
-        """This scene with some keys set, validated again.
-
-        Parameters
-        ----------
-        overrides : dict, str or iterable of str or (str, value)
-            ``{"contact.max_friction": 2e5}``, one ``"contact.max_friction=2e5"`` string
-            (as ``--set`` takes it), or an iterable of such strings or (key, value)
-            pairs.
-
-        Returns
-        -------
-        Scene
-            A new scene; this one is unchanged.
-
-        Raises
-        ------
-        SceneError
-            An unknown key, an unparsable value, or a broken rule.
-
-        Examples
-        --------
-        >>> stiffer = scene.with_overrides({"contact.max_friction": 2e5})  # doctest: +SKIP
-        >>> finer = scene.with_overrides("numerics.elements=600")         # doctest: +SKIP
-        """
-        data = self.to_dict()
-        for key, value in assignments(overrides):
-            set_key(data, key, value)
-        return Scene(data, source=self.source)
-
-    # sections ---------------------------------------------------------
-    @property
-    def title(self) -> str:
-        """The scene's title ("" when it has none)."""
-        return self._data.get("title", "")
-
     # the sections, as the typed dataclasses of beltsim.problem.builder
     beam = _SectionOf(Beam)
     motion = _SectionOf(Motion)
@@ -316,48 +166,6 @@ class Scene:
     def params(self) -> Params:
         """The physical data a solver needs, derived from the sections."""
         return params_of(self._data)
-
-    def to_toml(self) -> str:
-        """The scene as a scene file; :meth:`loads` reads it back as the same scene.
-
-        Returns
-        -------
-        str
-            TOML text: the title, then one table per section, in the schema's order.
-        """
-        lines = []
-        if "title" in self._data:
-            lines.append(f"title = {toml_value(self._data['title'])}")
-        for section in SCHEMA:
-            if section not in self._data:
-                continue
-            lines.append(f"\n[{section}]")
-            for key, value in self._data[section].items():
-                lines.append(f"{key} = {toml_value(value)}")
-        return "\n".join(lines).lstrip("\n") + "\n"
-
-    def __eq__(self, other):
-        # the same keys and values; where a scene was read from does not count
-        if not isinstance(other, Scene):
-            return NotImplemented
-        return self._data == other._data
-
-    def __hash__(self):
-        # a scene does not change once made: equal scenes hash alike, as dictionary keys
-        return hash(_frozen(self._data))
-
-    def __repr__(self):
-        return f"Scene({self.title or self.source or 'untitled'!r})"
-
-
-
-def _frozen(value):
-    """A scene's tables as nested sorted tuples, which hash (equal tables, equal tuples)."""
-    if isinstance(value, dict):
-        return tuple(sorted((k, _frozen(v)) for k, v in value.items()))
-    if isinstance(value, list):
-        return tuple(_frozen(v) for v in value)
-    return value
 
 
 def _table(name: str, section):

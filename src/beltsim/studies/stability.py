@@ -19,6 +19,7 @@ from .. import solvers
 from ..api import is_drive_scene, shipped_scene
 from ..errors import BeltsimError, SceneError
 from ..problem.scene import Scene
+from ..problem.tables import frozen
 from ..simulation.controller import Simulation
 from ..simulation.readout import readout_class
 from ..simulation.result import RunStatus
@@ -247,13 +248,13 @@ def stability_cell(case: Case, scheme: str, extra=(), bounds=None, discrete=Fals
 
 
 def _steady_key(scene) -> tuple:
-    """The scene's steady problem on its grid as a key (:func:`_frozen`): the time-stepping
+    """The scene's steady problem on its grid as a key (:func:`~beltsim.problem.tables.frozen`): the time-stepping
     keys and the title change neither its steady state nor its verdict."""
     from ..physics.modes import steady_scene
 
     data = steady_scene(scene).to_dict()
     data.pop("title", None)
-    return _frozen(data)
+    return frozen(data)
 
 
 def _discrete_reference(scene):
@@ -279,18 +280,8 @@ def steady_state_stability(scene) -> tuple[bool, str, float]:
     return _VERDICTS[key]
 
 
-#: Verdicts by the scene's data (:func:`_frozen`): the schemes of a case share one.
+#: Verdicts by the scene's data (:func:`~beltsim.problem.tables.frozen`): the schemes of a case share one.
 _VERDICTS: dict[tuple, tuple[bool, str, float]] = {}
-
-
-def _frozen(value):
-    """A scene's data as a hashable value: tables as sorted (key, value) tuples, arrays
-    (a drive's rows) as tuples."""
-    if isinstance(value, dict):
-        return tuple(sorted((k, _frozen(v)) for k, v in value.items()))
-    if isinstance(value, list):
-        return tuple(_frozen(v) for v in value)
-    return value
 
 
 def _stability_verdict(scene) -> tuple[bool, str, float]:
