@@ -56,7 +56,9 @@ def matrix_section(page: Page, quick: bool) -> None:
         "bounded throughout), *refused* (a rule of the scene or its numerics, before "
         "anything runs), *not applicable*, *unstable steady state* (the time-accurate run "
         "did not settle and the model linearised about its steady state has a growing "
-        "mode), or a failure: *out of bounds*, *not converged*, *diverged*.")
+        "mode), *physical outcome* (a drive's gross slip or lift-off, where it has no "
+        "steady state), or a failure: *out of bounds*, *not converged* (a gross slip or "
+        "lift-off where the steady state exists counts here), *diverged*.")
     if quick:
         page.para(
             f"This is the coarse matrix of `--quick`: every case on {QUICK_ELEMENTS} "

@@ -99,7 +99,8 @@ class LoopDiscretisation(Discretisation):
                                     0.0 if P.mu is None else P.mu, (0.0, P.J2))
         code = num.law_code
         self.model: ModelParams = loop_params(
-            a=P.a, b1=P.b1, b2=P.b2, rho=P.rho, I=P.I, lever=P.lever, damping=P.damping,
+            a=P.a, b1=P.b1, b2=P.b2, rho=P.rho, I=P.I, lever=P.lever,
+            damping=P.damping + num.acceleration,
             N0=P.N0, law=code, dual=int(has_dual(code) and code != LINEAR and code < EXACT),
             regularisation=num.regularisation, friction_scale=num.friction_scale,
             gyro=num.gyro_code)

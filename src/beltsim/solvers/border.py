@@ -92,6 +92,24 @@ def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
             bd.Dm[2 * b + k, 2 * b + m] = Gd[k, m]
 
 
+@njit(cache=True)
+def border_row_dot(bd, r, y):
+    """sum over the band's rows i and unknowns a of Cm[r, i, a] y[i, a]: a border node's
+    row reaches only the band's rows 0, ni - 2 and ni - 1 (:func:`gather`), a global's
+    every row."""
+    ni, b = bd.Cm.shape[1], bd.Cm.shape[2]
+    acc = 0.0
+    if r < 2 * b:
+        for i in (0, ni - 2, ni - 1):
+            for a in range(b):
+                acc += bd.Cm[r, i, a] * y[i, a]
+        return acc
+    for i in range(ni):
+        for a in range(b):
+            acc += bd.Cm[r, i, a] * y[i, a]
+    return acc
+
+
 @njit(cache=True, error_model="numpy")
 def schur(bd):
     """bd.Sinv from bd.X = A^{-1} Bm; False when the complement is singular."""
@@ -99,11 +117,7 @@ def schur(bd):
     S = bd.Dm.copy()
     for r in range(nb):
         for q in range(nb):
-            acc = 0.0
-            for i in range(bd.Cm.shape[1]):
-                for a in range(bd.Cm.shape[2]):
-                    acc += bd.Cm[r, i, a] * bd.X[q, i, a]
-            S[r, q] -= acc
+            S[r, q] -= border_row_dot(bd, r, bd.X[q])
     # scale rows and columns to unit diagonal-ish size: the border mixes metres, N and 1/s
     d = np.ones(nb)
     for r in range(nb):
@@ -134,11 +148,7 @@ def finish(bd, r, rg, x, dg):
     for k in range(nb - 2 * b):
         bd.rb[2 * b + k] = rg[k]
     for q in range(nb):
-        acc = 0.0
-        for i in range(ni):
-            for a in range(b):
-                acc += bd.Cm[q, i, a] * x[i, a]
-        bd.rb[q] -= acc
+        bd.rb[q] -= border_row_dot(bd, q, x)
     z = bd.Sinv @ bd.rb
     for q in range(nb):
         for i in range(ni):

@@ -56,7 +56,7 @@ from .implicit import (
     predict_friction,
     step_factor,
 )
-from .newton import FAILED, NONFINITE, OK, newton
+from .newton import FAILED, NONFINITE, OK, newton, on_path
 from .registry import register
 
 GAMMA = 1767732205903.0 / 4055673282236.0
@@ -241,7 +241,8 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
                 for j in range(nodes):
                     lam[j] = lam_2[j]
                 predict_friction(lam, lam_n, x - 1.0, mesh, p.law)
-            ok = newton(state, base, a0, t + s, mesh, p, drive, loads, scales, settings, w)
+            ok = (newton(state, base, a0, t + s, mesh, p, drive, loads, scales, settings, w)
+                  and on_path(g, g_n, scales))
             if not ok:
                 break
             for j in range(nodes):

@@ -40,7 +40,7 @@ from numba import njit
 from ..physics.friction import EXACT
 from ..physics.model import LAM_MAX, POWER_TERMS, loop_speed, power_terms, rate_part
 from ..problem.drive import friction_factor
-from .newton import FAILED, NONFINITE, OK, NewtonScheme, linear_solve, newton
+from .newton import FAILED, NONFINITE, OK, NewtonScheme, linear_solve, newton, on_path
 from .registry import register
 
 SAFETY = 0.8
@@ -210,7 +210,8 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
             g[k] = g_n[k] + h * gd_n[k]
         if h_prev > 0.0:
             predict_friction(lam, hist.lam, h / h_prev, mesh, p.law)
-        ok = newton(state, base, a0, t + h, mesh, p, drive, loads, scales, settings, w)
+        ok = (newton(state, base, a0, t + h, mesh, p, drive, loads, scales, settings, w)
+              and on_path(g, g_n, scales))
         err = 0.0
         finite = True
         if ok:

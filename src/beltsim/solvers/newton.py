@@ -475,6 +475,18 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
 
 
 @njit(cache=True)
+def on_path(g, g_start, scales):
+    """Whether a step kept a loop's globals within their scales (the rim speed, the
+    pulley's speed) of the step's start: one that moved them further converged on another
+    branch of the exact laws' equations (the belt sliding backwards over every arc), not
+    on the path, and is cut like a failed one. Always true on an open layout."""
+    for k in range(g.shape[0]):
+        if not abs(g[k] - g_start[k]) <= scales.glob[k]:
+            return False
+    return True
+
+
+@njit(cache=True)
 def shift_saddle(state, s, mesh, alpha):
     """(u, theta, the friction ratios, the globals) += alpha times the semi-smooth
     Newton update in s."""

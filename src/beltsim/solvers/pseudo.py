@@ -3,7 +3,8 @@
 The fast way to a steady state when the path does not matter: backward Euler's
 first-order dissipation, and ``numerics.acceleration`` on top of the scene's damping,
 shape the path, not the steady state (both act on local rates only). A step whose
-Newton iteration fails is retried with a quarter of the time step; after a run of
+Newton iteration fails, or a loop's step that moves its belt speed or a pulley's speed
+by more than their scales, is retried with a quarter of the time step; after a run of
 four successes the step grows back towards its nominal value. The same kernel serves
 inertial and quasistatic scenes: with rho = I = 0 the residual is algebraic except
 for the slip velocity, an index-1 DAE that backward Euler handles as is.
@@ -14,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .newton import FAILED, NONFINITE, OK, NewtonScheme, newton
+from .newton import FAILED, NONFINITE, OK, NewtonScheme, newton, on_path
 from .registry import register
 
 
@@ -62,7 +63,8 @@ def advance_backward_euler(state, old, t, t_stop, dt, dt_nominal, max_steps, mes
             th[j] = tho[j] + h * tdo[j]
         for k in range(g.shape[0]):
             g[k] = go[k] + h * gdo[k]
-        ok = newton(state, old, inv, t + h, mesh, p, drive, loads, scales, settings, w)
+        ok = (newton(state, old, inv, t + h, mesh, p, drive, loads, scales, settings, w)
+              and on_path(g, go, scales))
         if ok:
             finite = True
             for j in range(N + 1):

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from .. import solvers
 from ..api import is_drive_scene, shipped_scene
-from ..errors import BeltsimError, SceneError
+from ..errors import BeltsimError, NoSolutionError, SceneError
 from ..problem.scene import Scene
 from ..problem.tables import frozen
 from ..simulation.controller import Simulation
@@ -58,18 +58,23 @@ class CellStatus(enum.StrEnum):
     #: a time-accurate run diverged or did not settle, and the eigenvalues of the model
     #: linearised about its steady state show a growing mode (physics.modes)
     UNSTABLE = "unstable steady state"
+    #: a drive ended in gross slip or lift-off, and has no steady state to reach
+    OUTCOME = "physical outcome"
 
 
 #: Statuses that count as a pass: the scheme either delivers or says why it cannot (an
 #: unstable steady state is a reason the model itself gives, with its growth rate).
 ACCEPTED = (CellStatus.CONVERGED, CellStatus.BOUNDED, CellStatus.REFUSED,
-            CellStatus.NOT_APPLICABLE, CellStatus.UNSTABLE)
+            CellStatus.NOT_APPLICABLE, CellStatus.UNSTABLE, CellStatus.OUTCOME)
 #: A growth rate counts as unstable above this fraction of max(|lambda|, c / L): growth
 #: of at least 1e-3 per radian of the mode's oscillation and per transit (far above
 #: the eigensolver's round-off).
 GROWTH_MARGIN = 1e-3
+#: a gross slip or a lift-off where the exact steady state exists did not reach it
 _RUN_STATUS = {RunStatus.FAILED: CellStatus.DIVERGED, RunStatus.REACHED_END:
-               CellStatus.NOT_CONVERGED, RunStatus.INTERRUPTED: CellStatus.NOT_CONVERGED}
+               CellStatus.NOT_CONVERGED, RunStatus.INTERRUPTED: CellStatus.NOT_CONVERGED,
+               RunStatus.GROSS_SLIP: CellStatus.NOT_CONVERGED,
+               RunStatus.LIFT_OFF: CellStatus.NOT_CONVERGED}
 
 
 @dataclass(frozen=True)
@@ -117,6 +122,8 @@ DRIVE_CASES = (
          (("drive.driven_inertia", 2.0e-4),)),
     Case("drive: heavy driven pulley (J2 x 50)", "drive_flat", (("drive.driven_inertia", 1.0),)),
     Case("drive: load at 0.95 of the capacity", "drive_flat", (("drive.load_torque", 93.5),)),
+    Case("drive: load at 1.05 of the capacity (gross slip)", "drive_flat",
+         (("drive.load_torque", 103.4),)),
     Case("drive: undamped belt", "drive_flat", (("physics.damping", 0.0),)),
 )
 _THIN = (("beam.height", 0.01),)
@@ -198,7 +205,12 @@ def stability_cell(case: Case, scheme: str, extra=(), bounds=None, discrete=Fals
         key = exc.key if isinstance(exc, SceneError) else type(exc).__name__
         cell.update(status=CellStatus.REFUSED, reason=str(exc), reason_key=key or "")
         return cell
-    res = sim.run(raise_on_failure=False)
+    try:
+        res = sim.run(raise_on_failure=False)
+    except NoSolutionError as exc:  # the steady scheme refuses a drive with no steady state
+        cell.update(status=CellStatus.REFUSED, reason=str(exc),
+                    reason_key=type(exc).__name__)
+        return cell
     own_grid = _discrete_reference(scene) if discrete else None
     if own_grid is not None:
         bounds = DRIVE_DISCRETE_BOUNDS if closed else DISCRETE_BOUNDS
@@ -214,6 +226,10 @@ def stability_cell(case: Case, scheme: str, extra=(), bounds=None, discrete=Fals
         cell.update(status=CellStatus.BOUNDED,
                     reason=f"t = {res.simulated_time:.3g} s, final rate "
                            f"{res.history['rate'][-1]:.3g}")
+    elif (res.status in (RunStatus.GROSS_SLIP, RunStatus.LIFT_OFF)
+          and sim.readout.reference() is None):
+        cell.update(status=CellStatus.OUTCOME, reason=res.reason,
+                    reason_key=res.status.value)
     elif not res.converged:
         # what stopped the run: the kind of failure, else the status it ended in
         cell.update(status=_RUN_STATUS[res.status], reason=res.reason,
@@ -248,8 +264,9 @@ def stability_cell(case: Case, scheme: str, extra=(), bounds=None, discrete=Fals
 
 
 def _steady_key(scene) -> tuple:
-    """The scene's steady problem on its grid as a key (:func:`~beltsim.problem.tables.frozen`): the time-stepping
-    keys and the title change neither its steady state nor its verdict."""
+    """The scene's steady problem on its grid as a key (its tables frozen,
+    :func:`~beltsim.problem.tables.frozen`): the time-stepping keys and the title change
+    neither its steady state nor its verdict."""
     from ..physics.modes import steady_scene
 
     data = steady_scene(scene).to_dict()
@@ -280,7 +297,7 @@ def steady_state_stability(scene) -> tuple[bool, str, float]:
     return _VERDICTS[key]
 
 
-#: Verdicts by the scene's data (:func:`~beltsim.problem.tables.frozen`): the schemes of a case share one.
+#: Verdicts by the scene's data (its frozen tables): the schemes of a case share one.
 _VERDICTS: dict[tuple, tuple[bool, str, float]] = {}
 
 
