@@ -77,7 +77,12 @@ from .explicit_friction import (  # noqa: F401 (the scheme's constants and solve
     _predicted,
     _warm_start,
 )
-from .explicit_stability import explicit_amplification, explicit_stable_dt  # noqa: F401
+from .explicit_loop import advance_loop, gh_size
+from .explicit_stability import (  # noqa: F401 (as tests read them)
+    explicit_amplification,
+    explicit_stable_dt,
+    loop_stable_dt,
+)
 from .registry import register
 from .settings import EXPLICIT_RATE
 
@@ -87,14 +92,21 @@ EXPLICIT_SAFETY = 0.9  # default explicit step as a fraction of the stability li
 class History(NamedTuple):
     """What the scheme carries from step to step besides the State."""
 
-    va: np.ndarray  # u_t, theta_t after the last kick (N + 1)
+    va: np.ndarray  # u_t, theta_t after the last kick (a node each)
     wa: np.ndarray
     db: np.ndarray  # the last kick's bottom-fibre increments (contact nodes)
+    # a loop's (empty on the open layout): each contact node's v_rel / v_reg (the warm
+    # start; its state.lam holds the ratio) and its globals' history (explicit_loop.gh_size)
+    sv: np.ndarray = np.zeros(0)
+    gh: np.ndarray = np.zeros(0)
 
     @classmethod
-    def zeros(cls, n_nodes):
-        """All zero on ``n_nodes`` nodes."""
-        return cls(*(np.zeros(n_nodes) for _ in cls._fields))
+    def zeros(cls, n_nodes, n_globals=0):
+        """All zero on ``n_nodes`` nodes with ``n_globals`` globals (a loop's)."""
+        loop = n_globals > 0
+        return cls(np.zeros(n_nodes), np.zeros(n_nodes), np.zeros(n_nodes),
+                   np.zeros(n_nodes if loop else 0),
+                   np.zeros(gh_size(n_globals) if loop else 0))
 
 
 # numba tests a signed index for a negative value (and wraps it) at every access, a
@@ -331,8 +343,12 @@ def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, driv
     start from any state is second order. On return state.ud, state.td hold u_t,
     theta_t at t (the mean of the velocities before and after the last kick),
     state.fnode that kick's friction and state.lam each contact node's v_rel / v_reg
-    (the warm start of its scalar solve).
+    (the warm start of its scalar solve). A loop (``mesh.off`` = 0) is stepped by
+    :func:`beltsim.solvers.explicit_loop.advance_loop`.
     """
+    if mesh.off == 0:
+        return advance_loop(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, drive,
+                            loads)
     u, th, sfr, fnode, ud, td = state.u, state.theta, state.lam, state.fnode, state.ud, state.td
     va, wa, db = hist.va, hist.wa, hist.db
     N = u.shape[0] - 1
@@ -390,13 +406,20 @@ class ExplicitScheme(Scheme):
     of the von Neumann limit (inertial scenes)."""
 
     name = "explicit"
-    closed = False  # open layouts only, for now
     needs_inertia = True
 
     def __init__(self, disc):
         super().__init__(disc)
         P, num, grid = disc.params, self.numerics, disc.grid
-        limit = explicit_stable_dt(P, grid.h_min, disc.model.damping)
+        if disc.closed:
+            from ..beltdrive.scene import max_rim_speed
+
+            speed = max_rim_speed(disc.scene.to_dict())  # c stays below it
+            limit = loop_stable_dt(P, grid.h_min, disc.model.damping, speed)
+            where = f"at belt speeds 0 .. {speed:.4g} m/s, "
+        else:
+            limit = explicit_stable_dt(P, grid.h_min, disc.model.damping)
+            where = ""
         if not limit > 0.0:
             raise SceneError("numerics.integrator", "the explicit scheme has no stable step "
                              "for this scene; use the implicit integrator")
@@ -404,20 +427,22 @@ class ExplicitScheme(Scheme):
         if requested is not None and requested > limit:
             raise SceneError(
                 "numerics.dt", f"{requested:.6g} s exceeds the explicit stability limit "
-                f"{limit:.6g} s (von Neumann, on the smallest element, {grid.h_min:.3g} m: "
-                f"the waves of both fields with the shear, gyroscopic and friction terms)")
+                f"{limit:.6g} s (von Neumann, on the smallest element, {grid.h_min:.3g} m, "
+                f"{where}the waves of both fields with the shear, gyroscopic and friction "
+                f"terms)")
         dt = requested if requested is not None else EXPLICIT_SAFETY * limit
         steps = math.ceil(num.t_end / dt)
-        work = steps * (grid.n_elements + 1.0)
+        nodes = len(disc.mesh.hb)
+        work = steps * float(nodes)
         if work > num.max_work:
             raise SceneError(
                 "numerics.max_work", f"this explicit run may need {work:.3g} node-steps "
                 f"({steps:.3g} steps of {dt:.3g} s to t_end = {num.t_end:.4g} s, "
-                f"{grid.n_elements + 1} nodes; about {_duration(work / EXPLICIT_RATE)} at "
+                f"{nodes} nodes; about {_duration(work / EXPLICIT_RATE)} at "
                 f"{EXPLICIT_RATE:.0e} node-steps/s), above max_work = {num.max_work:.3g}; "
                 f'use numerics.integrator = "implicit", or raise numerics.max_work')
         self.numerics = dataclasses.replace(num, dt=dt)
-        self.hist = History.zeros(grid.n_elements + 1)
+        self.hist = History.zeros(nodes, disc.n_globals)
         self.hist_at = (math.nan, math.nan)  # the (t, dt) the history belongs to
 
     @property
@@ -426,7 +451,8 @@ class ExplicitScheme(Scheme):
 
     def _compile(self, state) -> None:
         # on copies: a resumed run's history must survive the warm-up
-        self._kernel(state.copy(), History.zeros(len(state.u)), True, 0.0, 0.0, 0)
+        self._kernel(state.copy(), History.zeros(len(state.u), len(state.g)), True, 0.0, 0.0,
+                     0)
 
     def _kernel(self, state, hist, fresh, t, t_stop, max_steps):
         d = self.disc
@@ -453,4 +479,5 @@ class ExplicitScheme(Scheme):
             return
         self.hist_at = tuple(float(v) for v in data["hist_at"])
         for k, a in zip(History._fields, self.hist):
-            a[:] = data[f"hist_{k}"]
+            if f"hist_{k}" in data:  # an open layout's checkpoint has no loop fields
+                a[:] = data[f"hist_{k}"]

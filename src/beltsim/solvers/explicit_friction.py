@@ -5,7 +5,8 @@ v_reg (the module notes of :mod:`beltsim.solvers.explicit`). That estimate is af
 the node's own force, so s solves s + kappa g(s) = s_pred: s_pred the estimate without
 the node's friction, kappa its slope. The laws with a closed form (linear, ramp, and the
 exact laws by projection) are solved by it, the smooth ones (tanh, sqrt) by a safeguarded
-Newton iteration from a warm start. The sweeps of :mod:`beltsim.solvers.explicit` call
+Newton iteration from a warm start. Both layouts' sweeps (the open layout's in
+:mod:`beltsim.solvers.explicit`, a loop's in :mod:`beltsim.solvers.explicit_loop`) call
 these.
 """
 

@@ -6,7 +6,8 @@ one step of :mod:`beltsim.solvers.explicit` (the trapezoidal velocity terms with
 drift, the kick, friction at a slope k with its velocity estimate and the transport of
 the slip velocity). :func:`explicit_stable_dt` is the largest step whose amplification
 is at most 1 for every kh and every friction slope of FRICTION_Z on the smallest
-element.
+element. A loop's belt speed varies: :func:`loop_stable_dt` takes the smallest of the
+limits at the belt speeds it can reach.
 """
 
 from __future__ import annotations
@@ -147,3 +148,25 @@ def explicit_stable_dt(params, h_min, damping):
     return _stable_dt(float(P.B), float(P.A), float(P.b2), float(P.rho), float(P.I),
                       float(P.c), float(P.h), float(h_min), float(damping))
 
+
+#: belt speeds at which a loop's limit is evaluated, as fractions of the largest
+LOOP_SPEEDS = (0.0, 0.5, 1.0)
+
+
+def loop_stable_dt(params, h_min, damping, speed):
+    """A loop's stable step: the smallest of :func:`explicit_stable_dt` at the belt
+    speeds c in LOOP_SPEEDS times ``speed`` (the driver's largest rim speed, which c stays
+    below), with the stiffnesses b1 - rho c^2, a - I c^2 of each and the lever's height.
+
+    params: a drive's DriveParams. The pulleys' speeds (implicit with their arcs), the
+    belt speed's change (a weak, lagged coupling) and the bound's dependence on the
+    pressure (relative size mu h / R of the elastic force) are not in the analysis.
+    """
+    P = params
+    limits = []
+    for f in LOOP_SPEEDS:
+        c = f * speed
+        at = SimpleNamespace(B=P.b1 - P.rho * c * c, A=P.a - P.I * c * c, b2=P.b2, rho=P.rho,
+                             I=P.I, c=c, h=2.0 * P.lever)
+        limits.append(explicit_stable_dt(at, h_min, damping))
+    return min(limits)

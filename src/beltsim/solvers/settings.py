@@ -269,6 +269,9 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
     t_end = nm.get("t_end", settle + 40.0 * transit)
     if dt > t_end:
         raise SceneError("numerics.dt", f"must be <= numerics.t_end = {t_end!r}, got {dt!r}")
+    if "max_work" in nm and integrator != "explicit":
+        raise SceneError("numerics.max_work", 'only for numerics.integrator = "explicit" (the '
+                         "other schemes' steps adapt)")
     creep = creep_speed(P)
     friction_scale = 1.0
     if P.mu is None:
@@ -288,4 +291,5 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
         newton_tol=nm.get("newton_tol", 1e-9),
         newton_max_iterations=nm.get("newton_max_iterations", 30),
         time_tol=nm.get("time_tol", LOOP_TIME_TOLS.get(integrator, DEFAULT_TIME_TOL)),
-        settle_time=settle, gyroscopic=nm.get("gyroscopic", "upwind"))
+        settle_time=settle, max_work=nm.get("max_work", DEFAULT_MAX_WORK),
+        gyroscopic=nm.get("gyroscopic", "upwind"))
