@@ -353,9 +353,35 @@ def test_steady_beam_converges_to_the_beams_exact_state():
 
 
 @pytest.mark.unit
-@pytest.mark.parametrize("integrator", ["explicit", "pseudo"])
-def test_schemes_that_do_not_run_a_loop_yet_are_refused_in_one_line(integrator):
-    """The explicit and pseudo-transient schemes step open layouts only, for now: a drive
-    that asks for one is refused naming the key and the schemes that run it."""
+def test_schemes_that_do_not_run_a_loop_yet_are_refused_in_one_line():
+    """The pseudo-transient scheme steps open layouts only, for now: a drive that asks
+    for it is refused naming the key and the schemes that run it."""
     with pytest.raises(SceneError, match=r"numerics.integrator.*closed drive.*esdirk3"):
-        run(flat(("numerics.integrator", integrator)))
+        run(flat(("numerics.integrator", "pseudo")))
+
+
+@pytest.mark.unit
+def test_a_quasistatic_drive_refuses_the_explicit_scheme_in_one_line():
+    """The explicit scheme steps inertia: a quasistatic drive that asks for it is refused
+    naming the key and the rule, in one line, before anything is built."""
+    with pytest.raises(SceneError) as err:
+        run(flat(("physics.inertia", False), ("numerics.integrator", "explicit")))
+    msg = str(err.value)
+    assert msg.startswith('numerics.integrator: "explicit" needs physics.inertia = true')
+    assert "\n" not in msg
+
+
+@pytest.mark.unit
+def test_max_work_is_for_the_explicit_scheme_on_a_drive_too():
+    """numerics.max_work on a drive: refused for another scheme, and an explicit run
+    above it is refused with the estimate, as on a straight belt."""
+    with pytest.raises(SceneError, match=r"^numerics.max_work: only for"):
+        run(flat(("numerics.max_work", 1e9)))
+    with pytest.raises(SceneError, match=r"^numerics.max_work: this explicit run may need"):
+        run(flat(("numerics.integrator", "explicit"), ("numerics.max_work", 1e3)))
+
+
+@pytest.mark.unit
+def test_the_explicit_scheme_on_a_drive_takes_the_upwind_gyroscopic_form_only():
+    with pytest.raises(SceneError, match=r'^numerics.gyroscopic: "central" is for the implicit'):
+        flat(("numerics.gyroscopic", "central"), ("numerics.integrator", "explicit"))

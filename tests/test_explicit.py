@@ -1,18 +1,24 @@
-"""The explicit scheme: its step limit, its order in time, zero damping, a numpy twin."""
+"""The explicit scheme: its step limit, its order in time, zero damping, a numpy twin;
+on both layouts where a property is the scheme's, and a loop's own: its fixed point (the
+steady scheme's state), its start-up against esdirk3, its gauge."""
+
+import math
 
 import numpy as np
 import pytest
 from scipy.optimize import brentq
 
 import beltsim
+from beltsim.beltdrive.scene import max_rim_speed
 from beltsim.physics import reference
 from beltsim.physics.friction import law_numpy
 from beltsim.physics.model import Loads, State
-from beltsim.problem.drive import mismatch
+from beltsim.problem.drive import mismatch, value
 from beltsim.problem.scene import Scene
 from beltsim.simulation.controller import Simulation
+from beltsim.simulation.result import RunStatus
 from beltsim.simulation.trackers import GROWTH_LIMIT
-from beltsim.solvers import Discretisation
+from beltsim.solvers import Discretisation, discretise
 from beltsim.solvers.explicit import (
     A_EST,
     ALPHA,
@@ -24,6 +30,7 @@ from beltsim.solvers.explicit import (
     advance_explicit,
     explicit_amplification,
     explicit_stable_dt,
+    loop_stable_dt,
 )
 from helpers import scene_path
 
@@ -34,6 +41,14 @@ def _scene(name, *overrides):
     return beltsim.load_scene(scene_path(name), ["numerics.elements=300", *overrides])
 
 
+def _limit(d):
+    """The explicit scheme's stable step of a discretisation of either layout."""
+    if d.closed:
+        return loop_stable_dt(d.params, d.grid.h_min, d.model.damping,
+                              max_rim_speed(d.scene.to_dict()))
+    return explicit_stable_dt(d.params, d.grid.h_min, d.model.damping)
+
+
 def _steps(d, state, hist, fresh, t, dt, n):
     """n explicit steps of size dt from t (the kernel alone); returns the new time."""
     t, done = advance_explicit(state, hist, fresh, t, np.inf, dt, n, d.mesh, d.model, d.drive,
@@ -42,14 +57,13 @@ def _steps(d, state, hist, fresh, t, dt, n):
     return t
 
 
-def test_requested_step_above_the_explicit_limit_is_refused():
-    sim = Simulation(_scene("paper_inertia", "numerics.integrator=explicit"))
+@pytest.mark.parametrize("name", ["paper_inertia", "drive_flat"])
+def test_requested_step_above_the_explicit_limit_is_refused(name):
+    sim = Simulation(_scene(name, "numerics.integrator=explicit"))
     limit = sim.numerics.dt / EXPLICIT_SAFETY
     with pytest.raises(beltsim.SceneError, match=r"^numerics\.dt: .* exceeds the explicit"):
-        Simulation(_scene("paper_inertia", "numerics.integrator=explicit",
-                          f"numerics.dt={1.01 * limit}"))
-    Simulation(_scene("paper_inertia", "numerics.integrator=explicit",
-                      f"numerics.dt={0.99 * limit}"))
+        Simulation(_scene(name, "numerics.integrator=explicit", f"numerics.dt={1.01 * limit}"))
+    Simulation(_scene(name, "numerics.integrator=explicit", f"numerics.dt={0.99 * limit}"))
 
 
 def test_limit_does_not_depend_on_damping_or_friction_stiffness():
@@ -104,12 +118,12 @@ def test_amplification_is_one_for_a_tiny_step_and_exceeds_one_beyond_the_limit(d
 
 def _self_convergence(d, state0, span, quantities=("u", "theta", "ud", "td", "fnode")):
     """Observed orders in time from runs at dt, dt/2, dt/4, dt/8 over the same span."""
-    limit = explicit_stable_dt(d.params, d.grid.h_min, d.model.damping)
-    n = int(np.ceil(span / (0.8 * limit)))
+    n = int(np.ceil(span / (0.8 * _limit(d))))
     finals = []
     for r in (1, 2, 4, 8):
         state = state0.copy()
-        t = _steps(d, state, History.zeros(len(state.u)), True, 0.0, span / (n * r), n * r)
+        t = _steps(d, state, History.zeros(len(state.u), len(state.g)), True, 0.0,
+                   span / (n * r), n * r)
         assert t == pytest.approx(span, rel=1e-12)
         finals.append(state)
     orders = {}
@@ -120,13 +134,26 @@ def _self_convergence(d, state0, span, quantities=("u", "theta", "ud", "td", "fn
     return orders
 
 
-def test_second_order_in_time_with_a_smooth_friction_law():
-    """During the ramp of the paper slip scene, with a wide regularisation (v_reg
-    0.05 m/s, so friction is smooth): positions, rates and friction forces converge
-    at second order."""
-    d = Discretisation(_scene("paper_slip", "numerics.elements=60",
-                              "numerics.regularisation=0.05"))
-    orders = _self_convergence(d, d.new_state(), 0.01)
+# the loop's theta and theta_t are left out: their differences between the steps (1e-12
+# rad, 1e-9 rad/s: a millionth of their size, the 2 mm lever's share of the friction)
+# do not halve regularly with dt (observed orders 0.5-3), while u, u_t, the friction, c
+# and omega_2 show 2.0 (1.93-2.04)
+SMOOTH_CASES = {
+    "open": ("paper_slip", ("numerics.regularisation=0.05",), 0.01, None),
+    "loop": ("drive_flat", ("numerics.friction_law=tanh", "numerics.regularisation=0.05"),
+             0.05, ("u", "ud", "fnode", "g", "gd")),
+}
+
+
+@pytest.mark.parametrize("layout", SMOOTH_CASES)
+def test_second_order_in_time_with_a_smooth_friction_law(layout):
+    """During the ramp, with a wide regularisation (v_reg 0.05 m/s, so friction is
+    smooth): positions, rates and friction forces (and a loop's belt and pulley speeds
+    and their rates) converge at second order."""
+    name, extra, span, quantities = SMOOTH_CASES[layout]
+    d = discretise(beltsim.load_scene(scene_path(name), ["numerics.elements=60", *extra]))
+    orders = (_self_convergence(d, d.new_state(), span) if quantities is None else
+              _self_convergence(d, d.new_state(), span, quantities))
     for q, o in orders.items():
         assert min(o) >= 1.9, (q, o)
 
@@ -187,10 +214,11 @@ def test_stiff_friction_sets_no_step_limit():
     assert np.abs(sim.state.u).max() < 10 * sim.disc.scales.u
 
 
-def test_chunks_continue_the_history():
+@pytest.mark.parametrize("name", ["paper_slip", "drive_flat"])
+def test_chunks_continue_the_history(name):
     """Advancing in chunks (as the run loop does) is the same arithmetic as one
     advance: the history carries over, bit for bit."""
-    scene = _scene("paper_slip", "numerics.integrator=explicit", "numerics.elements=80")
+    scene = _scene(name, "numerics.integrator=explicit", "numerics.elements=80")
     whole, parts = Simulation(scene), Simulation(scene)
     whole.advance(0.02)
     while parts.t < 0.02:
@@ -198,6 +226,73 @@ def test_chunks_continue_the_history():
     assert whole.steps == parts.steps and whole.t == parts.t
     for a, b in zip(whole.state, parts.state):
         np.testing.assert_array_equal(a, b)
+
+
+def _drive(*overrides):
+    return beltsim.load_scene(scene_path("drive_flat"), list(overrides))
+
+
+def _rel(a, b):
+    return float(np.abs(a - b).max() / np.abs(b).max())
+
+
+def test_a_drive_from_rest_ends_on_the_steady_schemes_state():
+    """A loop's fixed point is the model's semi-discrete steady state: drive_flat
+    (inertial) from rest by the explicit scheme until the run's steady test holds, against
+    the steady scheme's solve on the same grid."""
+    ex = beltsim.run(_drive("numerics.elements=100", "numerics.integrator=explicit"))
+    st = beltsim.run(_drive("numerics.elements=100", "numerics.integrator=steady"))
+    assert ex.status is RunStatus.CONVERGED
+    a, b = ex.solution.state, st.solution.state
+    errors = {q: _rel(getattr(a, q), getattr(b, q)) for q in ("u", "theta", "fnode", "g")}
+    # the run stops when its rates fall below steady_tol = 1e-7 (of their scales over a
+    # transit): what remains of the approach is of that order or less; measured u 1.6e-9,
+    # theta 1.5e-8, forces 1.5e-8, speeds 5.5e-10 (of their largest values)
+    assert max(errors.values()) < 1e-6, errors
+
+
+def test_a_drive_start_up_agrees_with_esdirk3():
+    """A start-up (0.2 s, in the driver's ramp) by the explicit scheme at about its
+    default step, against esdirk3 at time_tol 1e-7 at the same time: the same
+    semi-discrete path."""
+    T = 0.2
+    scene = _drive("numerics.elements=60")
+    probe = Simulation(scene.with_overrides({"numerics.integrator": "explicit"}))
+    n = math.ceil(T / probe.numerics.dt)
+    ex = Simulation(scene.with_overrides({"numerics.integrator": "explicit",
+                                          "numerics.dt": T / n}))
+    ex.advance(T)
+    es = Simulation(scene.with_overrides({"numerics.integrator": "esdirk3",
+                                          "numerics.time_tol": 1e-7}))
+    es.advance(ex.t)
+    a, b = ex.state, es.state
+    errors = {"c": abs(a.g[0] / b.g[0] - 1.0), "omega2": abs(a.g[1] / b.g[1] - 1.0),
+              "u": _rel(a.u, b.u), "fnode": _rel(a.fnode, b.fnode)}
+    # the explicit scheme's own time error at its step (4.5e-5 s) dominates: measured c
+    # 4.1e-7, omega2 1.2e-7, u 5.5e-5, forces 6.3e-4 (of the largest); at a quarter of
+    # the step they fall 6-16x (second order; esdirk3's own error then shows)
+    assert errors["c"] < 2e-6 and errors["omega2"] < 2e-6, errors
+    assert errors["u"] < 2e-4 and errors["fnode"] < 2e-3, errors
+
+
+def test_a_loops_gauge_and_momentum_hold():
+    """Through a start-up: the gauge sum hbar u = 0 and its rate sum hbar u_t = 0 hold to
+    round-off (the belt speed takes every uniform part of the velocities), and the last
+    kick's rates are the loop's momentum balance rho Lambda c_t = sum F and the driven
+    pulley's J omega_t = -M - R_2 (its arc's sum F)."""
+    sim = Simulation(_drive("numerics.elements=60", "numerics.integrator=explicit"))
+    sim.advance(0.2)
+    m, P, s = sim.disc.mesh, sim.disc.params, sim.state
+    L = m.loop_length
+    for a in (s.u, s.ud):
+        # a sum of N terms of size |a| rounds to about N ulps of it
+        assert abs(np.dot(m.hb, a)) <= 1e-13 * L * np.abs(a).max()
+    # rounding: the elastic forces' sum (zero round the loop) and the sums of N terms
+    assert P.rho * L * s.gd[0] == pytest.approx(np.sum(s.fnode), rel=1e-9)
+    load = sim.disc.drive.load
+    driven = np.sum(s.fnode[m.seg == 1])
+    assert P.J2 * s.gd[1] == pytest.approx(-value(load, sim.t) - P.geometry.R2 * driven,
+                                           rel=1e-12)
 
 
 def _explicit_step_numpy(d, u, th, va, wa, db, t, dt):
