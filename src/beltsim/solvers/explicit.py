@@ -84,7 +84,7 @@ from .explicit_stability import (  # noqa: F401 (as tests read them)
     loop_stable_dt,
 )
 from .registry import register
-from .settings import EXPLICIT_RATE
+from .settings import EXPLICIT_LOOP_RATE, EXPLICIT_RATE
 
 EXPLICIT_SAFETY = 0.9  # default explicit step as a fraction of the stability limit
 
@@ -434,12 +434,13 @@ class ExplicitScheme(Scheme):
         steps = math.ceil(num.t_end / dt)
         nodes = len(disc.mesh.hb)
         work = steps * float(nodes)
+        rate = EXPLICIT_LOOP_RATE if disc.closed else EXPLICIT_RATE
         if work > num.max_work:
             raise SceneError(
                 "numerics.max_work", f"this explicit run may need {work:.3g} node-steps "
                 f"({steps:.3g} steps of {dt:.3g} s to t_end = {num.t_end:.4g} s, "
-                f"{nodes} nodes; about {_duration(work / EXPLICIT_RATE)} at "
-                f"{EXPLICIT_RATE:.0e} node-steps/s), above max_work = {num.max_work:.3g}; "
+                f"{nodes} nodes; about {_duration(work / rate)} at "
+                f"{rate:.0e} node-steps/s), above max_work = {num.max_work:.3g}; "
                 f'use numerics.integrator = "implicit", or raise numerics.max_work')
         self.numerics = dataclasses.replace(num, dt=dt)
         self.hist = History.zeros(nodes, disc.n_globals)

@@ -57,6 +57,9 @@ T_F, T_S, T_G, T_D = 0, 1, 2, 3  # the force, v_rel / v_reg, the ratio, the incr
 N_T = 4
 # relative change of an arc's friction total below which its Newton iteration stops
 ARC_TOL = 1e-13
+# columns of the per-node coefficients of an advance (a row per node)
+C_IH, C_KM, C_KI = 0, 1, 2  # 1 / h_j, dt / (rho hbar_j), dt / (I hbar_j)
+N_C = 3
 
 
 def gh_size(n_globals: int) -> int:
@@ -89,16 +92,17 @@ def loop_arcs(mesh):
 
 
 @njit(cache=True, fastmath=SAFE_FASTMATH)
-def _loop_drift(u, th, va, wa, vb, wb, pq, c, dt, gauge, mesh, p):
+def _loop_drift(u, th, va, wa, vb, wb, pq, co, c, dt, gauge, mesh, p):
     """The velocity terms over dt with the drift, on the loop; returns c's change.
 
     (2/dt + d + G) vm + c_t = (2/dt) v_a for both fields (c_t in the axial one only),
     G the upwind gyroscopic term at the belt speed c: the cyclic solve (module notes),
     then the uniform correction to sum hbar vm = 0. vb, wb receive the velocities after
     the part (2 vm - v_a), u, theta drift by dt vm, and u loses ``gauge`` (the last
-    kick's round-off of sum hbar u / Lambda). pq: (N, 2) scratch.
+    kick's round-off of sum hbar u / Lambda). pq: (N, 2) scratch; co: the advance's
+    coefficients (C_*).
     """
-    he, hb = mesh.he, mesh.hb
+    hb = mesh.hb
     n = u.shape[0]
     s2 = 2.0 / dt
     base = s2 + p.damping
@@ -106,10 +110,10 @@ def _loop_drift(u, th, va, wa, vb, wb, pq, c, dt, gauge, mesh, p):
     yt = 0.0
     z = 1.0
     for j in range(n):
-        g = 2.0 * c / he[wrap(j - 1, n)]
-        piv = base + g
-        P = s2 / piv
-        Q = g / piv
+        g = 2.0 * c * co[wrap(j - 1, n), C_IH]
+        inv = 1.0 / (base + g)
+        P = s2 * inv
+        Q = g * inv
         pq[j, 0] = P
         pq[j, 1] = Q
         yu = P * va[j] + Q * yu
@@ -153,16 +157,18 @@ def _ratio_slope(code, sp, kap, s):
 
 
 @njit(cache=True, fastmath=SAFE_FASTMATH)
-def _arc_sweep(j0, count, rim, ce, ff, u, th, bb, eb, db, sv, trial, dt, mesh, p):
+def _arc_sweep(j0, count, rim, ce, ff, u, th, bb, eb, db, sv, trial, co, dt, mesh, p):
     """One contact arc's friction in the direction of the flow at the rim speed ``rim``
     (ce the belt speed of the kick; ff the friction factor): each node's scalar equation
     (explicit_friction) into ``trial``. Returns the arc's total force and its derivative
     in ``rim``, carried along the sweep through the transport of the increments."""
     n = u.shape[0]
     hh, code, reg = p.half_height, p.law, p.regularisation
-    sw, hb, wf = mesh.sw, mesh.hb, mesh.wf
+    sw, wf = mesh.sw, mesh.wf
+    inv_reg = 1.0 / reg
     s = mesh.seg[j0]
-    mu, R = mesh.seg_mu[s], mesh.seg_radius[s]
+    mu = mesh.seg_mu[s]
+    mu_r = mu / mesh.seg_radius[s]
     creep = ce * p.N0 / p.b1  # the target's part beyond the belt's total velocity
     pressure0 = p.N0 - p.mass * ce * ce
     al = ALPHA * dt
@@ -180,26 +186,24 @@ def _arc_sweep(j0, count, rim, ce, ff, u, th, bb, eb, db, sv, trial, dt, mesh, p
         b_j = u[j] + hh * th[j]
         t0, t1, t2 = ce * sw[j, 0], ce * sw[j, 1], ce * sw[j, 2]
         est_c = A_EST + al * t2
-        fm = dt / (p.mass * hb[j])
-        fi = dt * hh / (p.rotary_inertia * hb[j])
-        kb = fm + hh * fi
+        kb = co[j, C_KM] + hh * hh * co[j, C_KI]
         if mu == 0.0:
             bound = p.friction_scale * ff
         else:
             eps = sw[j, 0] * u[k2] + sw[j, 1] * u[k1] + sw[j, 2] * u[j]
-            bound = mu * (pressure0 + p.b1 * eps) / R
+            bound = mu_r * (pressure0 + p.b1 * eps)
         fh = wf[j] * max(bound, 0.0)
         est = (bb[j] + est_c * eb[j] - C_EST * db[j] + t0 * b_l2 + t1 * b_l1 + t2 * b_j
                + creep - rim)
-        sp = (est + al * t0 * d_l2 + al * t1 * d_l1) / reg
+        sp = (est + al * t0 * d_l2 + al * t1 * d_l1) * inv_reg
         if fh > 0.0:
-            kap = est_c * kb * fh / reg
+            kap = est_c * kb * fh * inv_reg
             sj, g = _friction_scalar(code, sp, kap, sv[j])
             dg = _ratio_slope(code, sp, kap, sj)
         else:
             sj, g, dg = sp, 0.0, 0.0
         F = -fh * g
-        dF = -fh * dg * (al * t0 * e_l2 + al * t1 * e_l1 - 1.0) / reg
+        dF = -fh * dg * (al * t0 * e_l2 + al * t1 * e_l1 - 1.0) * inv_reg
         d_j = eb[j] + kb * F
         trial[j, T_F] = F
         trial[j, T_S] = sj
@@ -215,7 +219,7 @@ def _arc_sweep(j0, count, rim, ce, ff, u, th, bb, eb, db, sv, trial, dt, mesh, p
 
 
 @njit(cache=True)
-def _commit(j0, count, trial, va, wa, db, sv, fnode, lam, dt, mesh, p):
+def _commit(j0, count, trial, va, wa, db, sv, fnode, lam, co, p):
     """Apply an arc's accepted sweep: the forces' kick, the increments, the warm starts,
     the ratios (state.lam) and the nodal forces."""
     n = va.shape[0]
@@ -223,8 +227,8 @@ def _commit(j0, count, trial, va, wa, db, sv, fnode, lam, dt, mesh, p):
     for i in range(count):
         j = wrap(j0 + i, n)
         F = trial[j, T_F]
-        va[j] += dt * F / (p.mass * mesh.hb[j])
-        wa[j] += dt * hh * F / (p.rotary_inertia * mesh.hb[j])
+        va[j] += co[j, C_KM] * F
+        wa[j] += co[j, C_KI] * hh * F
         db[j] = trial[j, T_D]
         sv[j] = trial[j, T_S]
         lam[j] = trial[j, T_G]
@@ -232,7 +236,7 @@ def _commit(j0, count, trial, va, wa, db, sv, fnode, lam, dt, mesh, p):
 
 
 @njit(cache=True, fastmath=SAFE_FASTMATH)
-def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, arcs, gb, dgp,
+def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co, arcs, gb, dgp,
                gtot, dg, t, dt, mesh, p, drive, loads):
     """The kick at t from the velocities vb, wb and globals gb before it (dgp: the last
     kick's increments of the globals, gtot: the free pulleys' arcs' last totals).
@@ -243,7 +247,7 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, arcs, g
     drift).
     """
     n = u.shape[0]
-    he, hb, hh = mesh.he, mesh.hb, p.half_height
+    hb, hh = mesh.hb, p.half_height
     rho, rot = p.mass, p.rotary_inertia
     ce = gb[0] + 0.5 * dgp[0]  # c at t: second order, as the velocities' estimate
     B = p.b1 - rho * ce * ce
@@ -253,9 +257,10 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, arcs, g
     for j in range(n):
         jm = wrap(j - 1, n)
         jp = wrap(j + 1, n)
-        eu = dt / (rho * hb[j]) * (B * (u[jp] - u[j]) / he[j] - B * (u[j] - u[jm]) / he[jm])
-        et = dt / (rot * hb[j]) * (A * (th[jp] - th[j]) / he[j] - A * (th[j] - th[jm]) / he[jm]
-                                   - p.shear * hb[j] * th[j])
+        ih, il = co[j, C_IH], co[jm, C_IH]
+        eu = co[j, C_KM] * B * ((u[jp] - u[j]) * ih - (u[j] - u[jm]) * il)
+        et = co[j, C_KI] * (A * ((th[jp] - th[j]) * ih - (th[j] - th[jm]) * il)
+                            - p.shear * hb[j] * th[j])
         if lk >= 0:
             eu += dt / rho * load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j)
             et += dt / rot * load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j)
@@ -274,7 +279,7 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, arcs, g
         j0, count, s = arcs[a, 0], arcs[a, 1], arcs[a, 2]
         K = mesh.seg_speed[s]
         if K < 1:
-            _arc_sweep(j0, count, rim1, ce, ff, u, th, bb, eb, db, sv, trial, dt, mesh, p)
+            _arc_sweep(j0, count, rim1, ce, ff, u, th, bb, eb, db, sv, trial, co, dt, mesh, p)
         else:
             # the arc with its pulley's increment: G = sum F_j(rim(G)), rim(G) =
             # R (omega_b + A_EST dt (-M - R G) / J - C_EST Delta omega_last)
@@ -285,7 +290,7 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, arcs, g
             lo, hi = -np.inf, np.inf
             for _ in range(100):
                 tot, dtot = _arc_sweep(j0, count, rim0 + drim * G, ce, ff, u, th, bb, eb,
-                                       db, sv, trial, dt, mesh, p)
+                                       db, sv, trial, co, dt, mesh, p)
                 phi = G - tot
                 step = phi / (1.0 - dtot * drim)  # the slope is >= 1: monotone
                 if phi > 0.0:
@@ -299,7 +304,7 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, arcs, g
                     G = 0.5 * (lo + hi)  # Newton left the bracket (it is finite then)
             gtot[K] = tot
             dg[K] = dt * (-load - R * tot) / J
-        _commit(j0, count, trial, va, wa, db, sv, fnode, lam, dt, mesh, p)
+        _commit(j0, count, trial, va, wa, db, sv, fnode, lam, co, p)
     # the gauge: the uniform correction to sum hbar v = 0 is c's increment
     total = 0.0
     for j in range(n):
@@ -327,6 +332,11 @@ def advance_loop(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, drive, l
     vb, wb, bb, eb = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
     trial = np.zeros((n, N_T))
     pq = np.zeros((n, 2))
+    co = np.zeros((n, N_C))
+    for j in range(n):
+        co[j, C_IH] = 1.0 / mesh.he[j]
+        co[j, C_KM] = dt / (p.mass * mesh.hb[j])
+        co[j, C_KI] = dt / (p.rotary_inertia * mesh.hb[j])
     gb = np.zeros(ng)
     dg = np.zeros(ng)
     if fresh:
@@ -340,8 +350,8 @@ def advance_loop(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, drive, l
         wb[:] = td
         gb[:] = g
         for _ in range(2):
-            gauge = _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, arcs,
-                               gb, dgp, gtot, dg, t, dt, mesh, p, drive, loads)
+            gauge = _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co,
+                               arcs, gb, dgp, gtot, dg, t, dt, mesh, p, drive, loads)
             for j in range(n):
                 vb[j] = 1.5 * ud[j] - 0.5 * va[j]
                 wb[j] = 1.5 * td[j] - 0.5 * wa[j]
@@ -353,12 +363,12 @@ def advance_loop(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, drive, l
     steps = 0
     t_reached = t_stop - 1e-9 * dt
     while t < t_reached and steps < max_steps:
-        dc = _loop_drift(u, th, va, wa, vb, wb, pq, ga[0], dt, gh[3 * ng], mesh, p)
+        dc = _loop_drift(u, th, va, wa, vb, wb, pq, co, ga[0], dt, gh[3 * ng], mesh, p)
         gb[:] = ga
         gb[0] += dc
         t += dt
         steps += 1
-        gh[3 * ng] = _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial,
+        gh[3 * ng] = _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co,
                                 arcs, gb, dgp, gtot, dg, t, dt, mesh, p, drive, loads)
         for k in range(ng):
             ga[k] = gb[k] + dg[k]

@@ -53,6 +53,7 @@ DEFAULT_TIME_TOL = TIME_TOLS[DEFAULT_INTEGRATOR]
 MIN_MISMATCH = 1e-8  # smallest nonzero |v/c - 1| a run accepts
 DEFAULT_MAX_WORK = 2e10  # node-steps of an explicit run
 EXPLICIT_RATE = 8e7  # node-steps per second of the explicit kernel (bench), for messages
+EXPLICIT_LOOP_RATE = 2e7  # the same on a loop (drive_flat, 800 elements: 2.0-2.6e7)
 MEMORY_PER_NODE = 600  # bytes a grid node costs a run at its peak
 MIN_REGULARISATION = 1e-12  # smallest regularisation velocity, relative to c
 DEFAULT_ADHESION_LAYER = 1e-6  # delta / L
