@@ -83,24 +83,40 @@ def test_limit_does_not_depend_on_damping_or_friction_stiffness():
     assert max(steps.values()) < 1.01 * min(steps.values())
 
 
-@pytest.mark.parametrize("damping", [0.0, 39.0])
-def test_explicit_limit_is_sharp(damping):
-    """Independent check of the von Neumann limit: just below it the kernel stays
-    bounded, 30% above it the same run grows without bound. v = c, so nothing but the
-    initial noise drives the state (and friction holds the contact zone in stick)."""
-    sc = _scene("paper_inertia", "numerics.grading=1", "numerics.elements=200",
-                "motion.surface_speed=120", f"physics.damping={damping}")
-    d = Discretisation(sc)
-    limit = explicit_stable_dt(d.params, d.grid.h_min, d.model.damping)
+# each layout with its scene's damping and none; a loop's limit is taken at its belt
+# speeds (loop_stable_dt)
+SHARP_CASES = {"open": ("paper_inertia", ("numerics.grading=1", "numerics.elements=200",
+                                          "motion.surface_speed=120")),
+               "loop": ("drive_flat", ("numerics.elements=100",))}
 
-    def growth(dt_factor):
+
+@pytest.mark.parametrize("layout, damping", [("open", 0.0), ("open", 39.0), ("loop", 0.0),
+                                             ("loop", 20.0)])
+def test_explicit_limit_is_sharp(layout, damping):
+    """Independent check of the von Neumann limit: just below it the kernel stays
+    bounded, 30% above it the same run grows without bound. The growth is that of
+    initial noise (1e-6 in u and theta; on a loop with its gauge removed) over the same
+    run without it: on the open layout v = c, so the run without noise stays at rest (and
+    friction holds the contact zone in stick); a loop starts up from rest."""
+    name, extra = SHARP_CASES[layout]
+    d = discretise(_scene(name, *extra, f"physics.damping={damping}"))
+    limit = _limit(d)
+    inner = slice(d.mesh.off, len(d.mesh.hb) - d.mesh.off)
+
+    def run(dt_factor, noise):
         state = d.new_state()
         rng = np.random.default_rng(0)
-        state.u[1:-1] = 1e-6 * rng.standard_normal(len(state.u) - 2)
-        state.theta[1:-1] = 1e-6 * rng.standard_normal(len(state.u) - 2)
+        state.u[inner] = noise * rng.standard_normal(len(state.u[inner]))
+        state.theta[inner] = noise * rng.standard_normal(len(state.u[inner]))
+        if d.closed:
+            state.u[:] -= np.dot(d.mesh.hb, state.u) / d.mesh.loop_length
         with np.errstate(all="ignore"):
-            _steps(d, state, History.zeros(len(state.u)), True, 0.0, dt_factor * limit, 20000)
-        return np.abs(state.u).max() / 1e-6
+            _steps(d, state, History.zeros(len(state.u), len(state.g)), True, 0.0,
+                   dt_factor * limit, 20000)
+        return state.u
+
+    def growth(dt_factor):
+        return np.abs(run(dt_factor, 1e-6) - run(dt_factor, 0.0)).max() / 1e-6
 
     assert growth(0.99) < 10.0
     assert not growth(1.3) < GROWTH_LIMIT  # overflowed or grew by > 1e4

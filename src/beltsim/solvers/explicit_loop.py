@@ -35,6 +35,9 @@ each friction node's own velocity, swept in the direction of the flow. On a loop
   Newton's method with the sweep's derivative carried along the arc (safeguarded by
   bisection). A pulley speed lagging one step grew a slow oscillation with the stuck arc.
 
+The kernels divide with numpy's error model: a run that diverges (a step above the
+limit) ends in inf or nan, which the run's guard reports, not in an exception.
+
 The fixed point is the semi-discrete steady state of the model (all increments vanish:
 every row, the gauge and the pulleys' balance hold), the one the steady scheme solves.
 A node whose pressure is not positive (the belt lifts off; the run reports it) carries
@@ -91,7 +94,7 @@ def loop_arcs(mesh):
     return arcs
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH)
+@njit(cache=True, fastmath=SAFE_FASTMATH, error_model="numpy")
 def _loop_drift(u, th, va, wa, vb, wb, pq, co, c, dt, gauge, mesh, p):
     """The velocity terms over dt with the drift, on the loop; returns c's change.
 
@@ -141,7 +144,7 @@ def _loop_drift(u, th, va, wa, vb, wb, pq, co, c, dt, gauge, mesh, p):
     return kap * (2.0 + p.damping * dt)
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always")
+@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always", error_model="numpy")
 def _ratio_slope(code, sp, kap, s):
     """d g / d s_pred of the root of s + kappa g(s) = s_pred (the sweep's derivative)."""
     if code == EXACT:
@@ -156,7 +159,7 @@ def _ratio_slope(code, sp, kap, s):
     return 0.0
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH)
+@njit(cache=True, fastmath=SAFE_FASTMATH, error_model="numpy")
 def _arc_sweep(j0, count, rim, ce, ff, u, th, bb, eb, db, sv, trial, co, dt, mesh, p):
     """One contact arc's friction in the direction of the flow at the rim speed ``rim``
     (ce the belt speed of the kick; ff the friction factor): each node's scalar equation
@@ -196,8 +199,8 @@ def _arc_sweep(j0, count, rim, ce, ff, u, th, bb, eb, db, sv, trial, co, dt, mes
         est = (bb[j] + est_c * eb[j] - C_EST * db[j] + t0 * b_l2 + t1 * b_l1 + t2 * b_j
                + creep - rim)
         sp = (est + al * t0 * d_l2 + al * t1 * d_l1) * inv_reg
-        if fh > 0.0:
-            kap = est_c * kb * fh * inv_reg
+        kap = est_c * kb * fh * inv_reg
+        if kap > 0.0:
             sj, g = _friction_scalar(code, sp, kap, sv[j])
             dg = _ratio_slope(code, sp, kap, sj)
         else:
@@ -218,7 +221,7 @@ def _arc_sweep(j0, count, rim, ce, ff, u, th, bb, eb, db, sv, trial, co, dt, mes
     return total, slope
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _commit(j0, count, trial, va, wa, db, sv, fnode, lam, co, p):
     """Apply an arc's accepted sweep: the forces' kick, the increments, the warm starts,
     the ratios (state.lam) and the nodal forces."""
@@ -235,7 +238,7 @@ def _commit(j0, count, trial, va, wa, db, sv, fnode, lam, co, p):
         fnode[j] = F
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH)
+@njit(cache=True, fastmath=SAFE_FASTMATH, error_model="numpy")
 def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co, arcs, gb, dgp,
                gtot, dg, t, dt, mesh, p, drive, loads):
     """The kick at t from the velocities vb, wb and globals gb before it (dgp: the last
@@ -315,7 +318,7 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co, arc
     return gauge / mesh.loop_length
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH)
+@njit(cache=True, fastmath=SAFE_FASTMATH, error_model="numpy")
 def advance_loop(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, drive, loads):
     """Steps of the explicit scheme on a loop from t until t >= t_stop (or max_steps).
     Returns (t, steps); explicit.advance_explicit describes the history and the state
