@@ -132,9 +132,11 @@ def test_amplification_is_one_for_a_tiny_step_and_exceeds_one_beyond_the_limit(d
     assert explicit_amplification(P, h, 1.3 * limit, damping) > 1.01
 
 
-def _self_convergence(d, state0, span, quantities=("u", "theta", "ud", "td", "fnode")):
-    """Observed orders in time from runs at dt, dt/2, dt/4, dt/8 over the same span."""
-    n = int(np.ceil(span / (0.8 * _limit(d))))
+def _self_convergence(d, state0, span, quantities=("u", "theta", "ud", "td", "fnode"),
+                      coarsest=0.8):
+    """Observed orders in time from runs at dt, dt/2, dt/4, dt/8 over the same span, dt
+    about ``coarsest`` of the stable step."""
+    n = int(np.ceil(span / (coarsest * _limit(d))))
     finals = []
     for r in (1, 2, 4, 8):
         state = state0.copy()
@@ -150,14 +152,17 @@ def _self_convergence(d, state0, span, quantities=("u", "theta", "ud", "td", "fn
     return orders
 
 
-# the loop's theta and theta_t are left out: their differences between the steps (1e-12
-# rad, 1e-9 rad/s: a millionth of their size, the 2 mm lever's share of the friction)
-# do not halve regularly with dt (observed orders 0.5-3), while u, u_t, the friction, c
-# and omega_2 show 2.0 (1.93-2.04)
+FIELDS = ("u", "theta", "ud", "td", "fnode")
+# a loop's theta and theta_t from steps at a tenth of its limit: its shear mode
+# (sqrt(b2 / I) = 2.0e4 rad/s, 3.2 kHz) turns through 1000 rad over the span, and the
+# scheme's phase error in it (omega^3 dt^2 t / 24) is below a radian only at steps below
+# about 5e-6 s; from the limit's steps their differences are not yet asymptotic (observed
+# 0.5-3), from a tenth 1.92-1.99. The other quantities from the limit's steps (1.93-2.04):
+# from a tenth, u and c_t reach round-off at the finest step
 SMOOTH_CASES = {
-    "open": ("paper_slip", ("numerics.regularisation=0.05",), 0.01, None),
+    "open": ("paper_slip", ("numerics.regularisation=0.05",), 0.01, ((FIELDS, 0.8),)),
     "loop": ("drive_flat", ("numerics.friction_law=tanh", "numerics.regularisation=0.05"),
-             0.05, ("u", "ud", "fnode", "g", "gd")),
+             0.05, ((("u", "ud", "fnode", "g", "gd"), 0.8), (("theta", "td"), 0.1))),
 }
 
 
@@ -166,10 +171,11 @@ def test_second_order_in_time_with_a_smooth_friction_law(layout):
     """During the ramp, with a wide regularisation (v_reg 0.05 m/s, so friction is
     smooth): positions, rates and friction forces (and a loop's belt and pulley speeds
     and their rates) converge at second order."""
-    name, extra, span, quantities = SMOOTH_CASES[layout]
+    name, extra, span, groups = SMOOTH_CASES[layout]
     d = discretise(beltsim.load_scene(scene_path(name), ["numerics.elements=60", *extra]))
-    orders = (_self_convergence(d, d.new_state(), span) if quantities is None else
-              _self_convergence(d, d.new_state(), span, quantities))
+    orders = {}
+    for quantities, coarsest in groups:
+        orders.update(_self_convergence(d, d.new_state(), span, quantities, coarsest))
     for q, o in orders.items():
         assert min(o) >= 1.9, (q, o)
 
