@@ -407,6 +407,129 @@ def test_explicit_step_matches_numpy_twin(name):
         np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-10 * np.abs(w).max(), err_msg=name_)
 
 
+def _loop_step_numpy(d, u, th, va, wa, db, ga, dgp, gauge, t, dt):
+    """Numpy twin of one explicit step on a loop, written from the scheme's definition
+    (solvers.explicit_loop): the velocity terms by the trapezoidal rule with the belt
+    speed's multiplier (a dense bordered solve), the drift, then the kick at t + dt with
+    friction solved node by node along each arc and the driven pulley's arc solved for
+    its total force. Returns u, theta, the velocities after the kick, its bottom
+    increments, the friction, the rates and the globals at t + dt and their rates."""
+    p, mesh = d.model, d.mesh
+    hb, he, sw, wf = mesh.hb, mesh.he, mesh.sw, mesh.wf
+    n, L, hh = len(u), mesh.loop_length, p.half_height
+    rho, rot = p.mass, p.rotary_inertia
+    c = ga[0]
+    G = np.zeros((n, n))  # the upwind gyroscopic term over the lumped mass
+    for j in range(n):
+        G[j, j] += 2 * c / he[j - 1]
+        G[j, j - 1] -= 2 * c / he[j - 1]
+    M = (2 / dt + p.damping) * np.eye(n) + G
+    bordered = np.block([[M, np.ones((n, 1))], [hb[None, :], np.zeros((1, 1))]])
+    sol = np.linalg.solve(bordered, np.r_[2 / dt * va, 0.0])
+    vm, ct = sol[:n], sol[n]
+    wm = np.linalg.solve(M, 2 / dt * wa)
+    vb, wb = 2 * vm - va, 2 * wm - wa
+    u1, th1 = u + dt * vm - gauge, th + dt * wm
+    cb, omb = c + dt * ct, ga[1]
+    t1 = t + dt
+    ce = cb + 0.5 * dgp[0]
+    B, A = p.b1 - rho * ce**2, p.a - rot * ce**2
+
+    def lap(f):
+        return (np.roll(f, -1) - f) / he - (f - np.roll(f, 1)) / np.roll(he, 1)
+
+    eu = dt * B * lap(u1) / (rho * hb)
+    et = dt * (A * lap(th1) - p.shear * hb * th1) / (rot * hb)
+    delta = eu + hh * et  # the bottom increments, friction added node by node
+    kb = dt * (1 / (rho * hb) + hh * hh / (rot * hb))
+    ub1 = u1 + hh * th1
+    F, ratio = np.zeros(n), np.zeros(n)
+    load, rim1 = value(d.drive.load, t1), value(d.drive.speed, t1)
+    R2, J2 = mesh.seg_radius[1], mesh.inertia[1]
+
+    def sweep(s, rim):
+        """The arc of segment s at the rim speed rim: forces into F, delta."""
+        nodes = np.flatnonzero(mesh.seg == s)
+        # the arc's nodes in the direction of the flow, from its entry
+        entry = next(j for j in nodes if mesh.seg[j - 1] != s)
+        order = [(entry + k) % n for k in range(len(nodes))]
+        for j in order:
+            idx = [(j - 2) % n, (j - 1) % n, j]
+            eps = sw[j] @ u1[idx]
+            bound = mesh.seg_mu[s] * (p.N0 + p.b1 * eps - rho * ce**2) / mesh.seg_radius[s]
+
+            def force(vhat, j=j, bound=bound):
+                return -wf[j] * bound * law_numpy(p.law, vhat / p.regularisation)[0]
+
+            def slip(vhat, j=j, idx=idx, force=force):
+                dj = delta[j] + kb[j] * force(vhat)
+                known = np.r_[delta[idx[:2]], dj]
+                return (vb[j] + hh * wb[j] + cb + A_EST * dj - C_EST * db[j]
+                        + ce * sw[j] @ (ub1[idx] + ALPHA * dt * known)
+                        + ce * p.N0 / p.b1 - rim)
+
+            span = abs(slip(0.0)) + 10 * kb[j] * wf[j] * abs(bound) + 1.0
+            vhat = brentq(lambda x: x - slip(x), -span, span, xtol=1e-15, rtol=1e-14)
+            F[j] = force(vhat)
+            ratio[j] = law_numpy(p.law, vhat / p.regularisation)[0]
+            delta[j] += kb[j] * F[j]
+        return order
+
+    base = delta.copy()
+    sweep(0, rim1)
+
+    def mismatch_of(total):
+        delta[mesh.seg == 1] = base[mesh.seg == 1]
+        rim = R2 * (omb + A_EST * dt * (-load - R2 * total) / J2 - C_EST * dgp[1])
+        arc = sweep(1, rim)
+        return total - F[arc].sum()
+
+    bound = 10 * np.abs(wf * p.N0).sum()
+    brentq(mismatch_of, -bound, bound, xtol=1e-14, rtol=1e-15)
+    driven = F[mesh.seg == 1].sum()
+    va1 = vb + eu + dt * F / (rho * hb)
+    wa1 = wb + et + dt * hh * F / (rot * hb)
+    dc = hb @ va1 / L
+    va1 -= dc
+    dom = dt * (-load - R2 * driven) / J2
+    g = np.array([cb + 0.5 * dc, omb + 0.5 * dom])
+    return (u1, th1, va1, wa1, delta, F, ratio, 0.5 * (vb + va1), 0.5 * (wb + wa1), g,
+            np.array([dc, dom]) / dt)
+
+
+def test_loop_step_matches_numpy_twin():
+    """One step on a loop (drive_flat with a regularised law mid-ramp, from random
+    fields, velocities, history and globals) against the numpy twin of the scheme's
+    definition: the kernel's sweeps, cyclic solve, gauge and pulley solve do what the
+    module notes say."""
+    d = discretise(_drive("numerics.elements=40", "numerics.friction_law=tanh"))
+    dt = EXPLICIT_SAFETY * _limit(d)
+    n = len(d.mesh.hb)
+    rng = np.random.default_rng(7)
+    strain = d.params.N0 / d.params.b1
+    u = 0.002 * strain * d.mesh.loop_length * rng.standard_normal(n)  # pressure > 0
+    th = 0.1 * strain * rng.standard_normal(n)
+    va, wa = 1e-2 * rng.standard_normal(n), 1e-1 * rng.standard_normal(n)
+    va -= d.mesh.hb @ va / d.mesh.loop_length
+    db = 1e-3 * rng.standard_normal(n)
+    ga, dgp = np.array([6.0, 37.0]), np.array([2e-3, 1e-2])
+    gauge = 1e-9  # the last kick's round-off, removed by this drift
+    t = 0.5 * d.numerics.ramp_time
+    want = _loop_step_numpy(d, u, th, va, wa, db, ga, dgp, gauge, t, dt)
+    gh = np.r_[ga, dgp, 0.0, 0.0, gauge]
+    state = State(u.copy(), th.copy(), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                  np.zeros(2), np.zeros(2))
+    hist = History(va.copy(), wa.copy(), db.copy(), np.zeros(n), gh)
+    _steps(d, state, hist, False, t, dt, 1)
+    on = d.mesh.seg >= 0
+    got = (state.u, state.theta, hist.va, hist.wa, hist.db[on], state.fnode, state.lam[on],
+           state.ud, state.td, state.g, state.gd)
+    want = want[:4] + (want[4][on],) + want[5:6] + (want[6][on],) + want[7:]
+    names = ("u", "theta", "va", "wa", "db", "fnode", "ratio", "ud", "td", "g", "gd")
+    for name_, g, w in zip(names, got, want):
+        np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-10 * np.abs(w).max(), err_msg=name_)
+
+
 @pytest.mark.parametrize("code", [0, 1, 2, 3])
 def test_friction_scalar_solves_its_equation(code):
     rng = np.random.default_rng(code)
