@@ -385,3 +385,30 @@ def test_a_stiff_belts_start_up_stays_on_the_path(integrator):
     steady = solve_steady(flat(*over))
     for key in ("tight_tension", "belt_speed", "driven_speed"):
         assert r.summary()[key] == pytest.approx(steady.summary()[key], rel=1e-6), key
+
+
+@pytest.mark.unit
+def test_a_quasistatic_drive_refuses_the_explicit_scheme_in_one_line():
+    """The explicit scheme steps inertia: a quasistatic drive that asks for it is refused
+    naming the key and the rule, in one line, before anything is built."""
+    with pytest.raises(SceneError) as err:
+        run(flat(("physics.inertia", False), ("numerics.integrator", "explicit")))
+    msg = str(err.value)
+    assert msg.startswith('numerics.integrator: "explicit" needs physics.inertia = true')
+    assert "\n" not in msg
+
+
+@pytest.mark.unit
+def test_max_work_is_for_the_explicit_scheme_on_a_drive_too():
+    """numerics.max_work on a drive: refused for another scheme, and an explicit run
+    above it is refused with the estimate, as on a straight belt."""
+    with pytest.raises(SceneError, match=r"^numerics.max_work: only for"):
+        run(flat(("numerics.max_work", 1e9)))
+    with pytest.raises(SceneError, match=r"^numerics.max_work: this explicit run may need"):
+        run(flat(("numerics.integrator", "explicit"), ("numerics.max_work", 1e3)))
+
+
+@pytest.mark.unit
+def test_the_explicit_scheme_on_a_drive_takes_the_upwind_gyroscopic_form_only():
+    with pytest.raises(SceneError, match=r'^numerics.gyroscopic: "central" is for the implicit'):
+        flat(("numerics.gyroscopic", "central"), ("numerics.integrator", "explicit"))

@@ -103,6 +103,7 @@ SCHEMA: dict[str, dict[str, Rule]] = {
         "snapshot_interval": POS,
         "gyroscopic": Rule("str", choices=("upwind", "central")),
         "acceleration": Rule("float", nonneg=True),
+        "max_work": POS,
     },
 }
 REQUIRED = {"belt": ("height", "width", "youngs_modulus", "poisson_ratio", "shear_factor"),
@@ -178,6 +179,9 @@ def validate(data: dict) -> dict:
     if contact["friction"] == "stick" and law not in (None, "exact"):
         raise SceneError("numerics.friction_law", f'a "stick" drive takes only "exact", '
                          f'got "{law}"')
+    if num.get("gyroscopic", "upwind") != "upwind" and num.get("integrator") == "explicit":
+        raise SceneError("numerics.gyroscopic", '"central" is for the implicit schemes; the '
+                         'explicit scheme has the upwind form only')
     if "regularisation" in num and (law in (None, "exact")):
         raise SceneError("numerics.regularisation", 'only with a regularised '
                          'numerics.friction_law ("tanh" or "sqrt"): exact friction has none')

@@ -54,149 +54,65 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from functools import lru_cache
-from types import SimpleNamespace
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from ..errors import SceneError
-from ..physics.friction import ADHESION, EXACT, LINEAR, RAMP, SQRT, TANH, law
-from ..physics.model import contact_stencil, hermite_weights, load_at
+from ..physics.friction import SQRT, TANH
+from ..physics.model import hermite_weights, load_at
 from ..problem.drive import friction_factor, mismatch
 from .base import Scheme
+from .explicit_friction import (  # noqa: F401 (the scheme's constants and solves, as tests read them)
+    A_EST,
+    ALPHA,
+    C_EST,
+    SAFE_FASTMATH,
+    TANH_SATURATED,
+    _closed_form,
+    _friction_scalar,
+    _law,
+    _newton,
+    _predicted,
+    _warm_start,
+)
+from .explicit_loop import advance_loop, gh_size
+from .explicit_stability import (  # noqa: F401 (as tests read them)
+    explicit_amplification,
+    explicit_stable_dt,
+    loop_stable_dt,
+)
 from .registry import register
-from .settings import EXPLICIT_RATE
+from .settings import EXPLICIT_LOOP_RATE, EXPLICIT_RATE
 
 EXPLICIT_SAFETY = 0.9  # default explicit step as a fraction of the stability limit
-SMALL_STEP = 1e-5  # relative Newton step below which the friction solve stops
-# fast-math flags that keep NaN and inf semantics (a failing run must still show them)
-SAFE_FASTMATH = {"reassoc", "contract", "arcp"}
-# friction's velocity estimate (module notes): consistency needs A_EST - C_EST = 1/2
-C_EST = 1.0 / 16.0
-A_EST = 0.5 + C_EST
-ALPHA = 0.5
-# friction slopes of the von Neumann analysis, as dt k (1/rho + (h/2)^2 / I): the
-# relaxation of the bottom-fibre velocity per step, from none (sliding) to stick
-FRICTION_Z = np.concatenate([[0.0], np.logspace(-3.0, 9.0, 17)])
-# amplification accepted as 1: eigenvalues on the unit circle carry round-off
-TOL = 1e-9
 
 
 class History(NamedTuple):
     """What the scheme carries from step to step besides the State."""
 
-    va: np.ndarray  # u_t, theta_t after the last kick (N + 1)
+    va: np.ndarray  # u_t, theta_t after the last kick (a node each)
     wa: np.ndarray
     db: np.ndarray  # the last kick's bottom-fibre increments (contact nodes)
+    # a loop's (empty on the open layout): each contact node's v_rel / v_reg (the warm
+    # start; its state.lam holds the ratio) and its globals' history (explicit_loop.gh_size)
+    sv: np.ndarray = np.zeros(0)
+    gh: np.ndarray = np.zeros(0)
 
     @classmethod
-    def zeros(cls, n_nodes):
-        """All zero on ``n_nodes`` nodes."""
-        return cls(*(np.zeros(n_nodes) for _ in cls._fields))
+    def zeros(cls, n_nodes, n_globals=0):
+        """All zero on ``n_nodes`` nodes with ``n_globals`` globals (a loop's)."""
+        loop = n_globals > 0
+        return cls(np.zeros(n_nodes), np.zeros(n_nodes), np.zeros(n_nodes),
+                   np.zeros(n_nodes if loop else 0),
+                   np.zeros(gh_size(n_globals) if loop else 0))
 
 
 # numba tests a signed index for a negative value (and wraps it) at every access, a
 # branch and a select that cost more than the arithmetic in the sweeps below: their
 # indices are unsigned
 _1, _2 = np.uint64(1), np.uint64(2)
-# |s| beyond which tanh(s) rounds to +-1 and its slope to 0 (exp(-2 s) < 2^-54)
-TANH_SATURATED = 19.0
-
-
-# tanh(s) = s + s z P(z) / Q(z), z = s^2, for |s| < TANH_RATIONAL (Cephes' tanh, within
-# an ulp; (1 - e) / (1 + e), e = exp(-2 |s|), cancels there: 3e-13 relative at s = 1e-4)
-TANH_RATIONAL = 0.625
-TANH_P = (-9.64399179425052238628e-1, -9.92877231001918586564e1, -1.61468768441708447952e3)
-TANH_Q = (1.12811678491632931402e2, 2.23548839060100448583e3, 4.84406305325125486048e3)
-
-
-@njit(cache=True, fastmath=SAFE_FASTMATH)
-def _law(code, s):
-    """friction.law, with tanh without a call to libm near s = 0 (stick, where the friction
-    solves run most) and where it is saturated (exp would underflow: libm's slow path;
-    1 and 0 are what it gives)."""
-    if code == TANH:
-        if abs(s) > TANH_SATURATED:
-            return math.copysign(1.0, s), 0.0
-        if abs(s) < TANH_RATIONAL:
-            z = s * s
-            num = (TANH_P[0] * z + TANH_P[1]) * z + TANH_P[2]
-            den = ((z + TANH_Q[0]) * z + TANH_Q[1]) * z + TANH_Q[2]
-            g = s + s * z * num / den
-            return g, 1.0 - g * g
-    return law(code, s)
-
-
-@njit(cache=True, inline="always")
-def _closed_form(code, s_pred, kappa):
-    """Solve s + kappa g(s) = s_pred for the laws with a closed form (linear, exact,
-    ramp); returns (s, g(s)) (for an exact law, g(s) in its set)."""
-    if code == LINEAR:
-        s = s_pred / (1.0 + kappa)
-        return s, s
-    # the exact laws, by projection: the node sticks (s = 0) if its ratio s_pred / kappa
-    # can hold it (always for adhesion), else slides with the ratio on the bound
-    if code == ADHESION or (code == EXACT and abs(s_pred) <= kappa):
-        return 0.0, s_pred / kappa
-    if code == RAMP and abs(s_pred) <= 1.0 + kappa:
-        s = s_pred / (1.0 + kappa)
-        return s, s
-    return (s_pred - kappa, 1.0) if s_pred > 0 else (s_pred + kappa, -1.0)
-
-
-@njit(cache=True)
-def _friction_scalar(code, s_pred, kappa, s0):
-    """Solve s + kappa g(s) = s_pred; returns (s, g(s)) (for an exact law, g(s) in its set).
-
-    The laws with a closed form by it, the smooth ones by _newton from s0.
-    """
-    if code != TANH and code != SQRT:
-        return _closed_form(code, s_pred, kappa)
-    g0, gp0 = _law(code, s0)
-    return _newton(code, s_pred, kappa, s0, g0, gp0)
-
-
-@njit(cache=True, fastmath=SAFE_FASTMATH)
-def _newton(code, s_pred, kappa, s0, g0, gp0):
-    """Solve s + kappa g(s) = s_pred for a smooth law; g0, gp0: g, g' at s0.
-
-    g is odd, increasing and |g| <= 1, so the root lies in [s_pred - kappa, s_pred +
-    kappa]. Newton from s0 (the node's value at the previous step, so one or two
-    iterations in a settled state), safeguarded by bisection. A sliding node's root lies
-    at the edge of that interval, to round-off: s0 is clamped into it, not replaced, and
-    a converged step may end on the edge (strict bounds sent a third of the steps of
-    sliding nodes to bisection, 10-20 iterations).
-    """
-    lo, hi = s_pred - kappa, s_pred + kappa
-    s = min(max(s0, lo), hi)
-    g, gp = (g0, gp0) if s == s0 else _law(code, s)
-    tol = 1e-13 * (abs(s_pred) + kappa)
-    edge = 1e-15 * (abs(s_pred) + kappa)  # round-off of lo and hi
-    last_step = hi - lo
-    for _ in range(100):
-        r = s + kappa * g - s_pred
-        ds = -r / (1.0 + kappa * gp)
-        if abs(ds) <= SMALL_STEP * (1.0 + abs(s)) and lo - edge <= s + ds <= hi + edge:
-            # g linearised over the step: error g'' ds^2 / 2 < 1e-10, and none at a
-            # fixed point; in a settled run this is the first iteration (ds ~ 1e-7)
-            ds = min(max(s + ds, lo), hi) - s
-            return s + ds, g + gp * ds
-        if abs(r) <= tol:
-            return s, g
-        if r > 0.0:
-            hi = s
-        else:
-            lo = s
-        # bisection when Newton leaves the bracket or stops halving its steps (it can
-        # cycle across the inflection at s = 0 when it starts far out)
-        if not (lo < s + ds < hi) or abs(ds) > 0.5 * last_step:
-            ds = 0.5 * (lo + hi) - s
-        last_step = abs(ds)
-        s += ds
-        g, gp = _law(code, s)
-    return s, g
 
 
 # columns of Coefficients.fr, the friction nodes' coefficients: a row per node, so the
@@ -258,47 +174,6 @@ def coefficients(dt, mesh, p):
         f[FR_KAP] = f[FR_EST] * f[FR_KB] * f[FR_FH] / p.regularisation
     return co
 
-
-@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always")
-def _warm_start(code, s, kappa):
-    """(g, g', 1 / (1 + kappa g'), gc, gs) at a node's warm start s: the law, its slope
-    and the response to s_pred predicted from it, g ~ gc + gs s_pred: for a smooth law
-    the first Newton iteration of _friction_scalar (written out), for the others the
-    closed form in the warm start's regime (stick or slide, linear part or bound)."""
-    if code == TANH or code == SQRT:
-        g, gp = _law(code, s)
-    else:
-        bound = 1.0 if code == RAMP else 0.0
-        if code == LINEAR or (code == RAMP and abs(s) <= bound):
-            return 0.0, 0.0, 0.0, 0.0, 1.0 / (1.0 + kappa)
-        if code == ADHESION or (code == EXACT and s == 0.0):
-            return 0.0, 0.0, 0.0, 0.0, 1.0 / kappa
-        return 0.0, 0.0, 0.0, math.copysign(1.0, s), 0.0
-    inv = 1.0 / (1.0 + kappa * gp)
-    gs = gp * inv
-    return g, gp, inv, g - gs * (s + kappa * g), gs
-
-
-@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always")
-def _predicted(code, s_pred, kappa, s0, g0, gp, inv):
-    """(ok, s, g): the root of s + kappa g(s) = s_pred if the warm start's prediction
-    (_warm_start) holds, else ok is False. For a smooth law: the first Newton iteration
-    from s0 when it converges (most node-steps), for the others: the closed form when
-    the node stays in its regime."""
-    if code == TANH or code == SQRT:
-        ds = (s_pred - s0 - kappa * g0) * inv
-        edge = 1e-15 * (abs(s_pred) + kappa)  # round-off of the bracket's ends
-        if (abs(s0 - s_pred) <= kappa and abs(ds) <= SMALL_STEP * (1.0 + abs(s0))
-                and abs(s0 + ds - s_pred) <= kappa + edge):
-            ds = min(max(s0 + ds, s_pred - kappa), s_pred + kappa) - s0
-            return True, s0 + ds, g0 + gp * ds
-        return False, 0.0, 0.0
-    s, g = _closed_form(code, s_pred, kappa)
-    if code == LINEAR or code == ADHESION:
-        return True, s, g
-    bound = 1.0 if code == RAMP else 0.0
-    same = (abs(s) <= bound) == (abs(s0) <= bound) and (abs(s) <= bound or s * s0 > 0.0)
-    return same, s, g
 
 
 # columns of the friction pass's work array (a row per node): what the sweep needs of
@@ -468,8 +343,12 @@ def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, driv
     start from any state is second order. On return state.ud, state.td hold u_t,
     theta_t at t (the mean of the velocities before and after the last kick),
     state.fnode that kick's friction and state.lam each contact node's v_rel / v_reg
-    (the warm start of its scalar solve).
+    (the warm start of its scalar solve). A loop (``mesh.off`` = 0) is stepped by
+    :func:`beltsim.solvers.explicit_loop.advance_loop`.
     """
+    if mesh.off == 0:
+        return advance_loop(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, drive,
+                            loads)
     u, th, sfr, fnode, ud, td = state.u, state.theta, state.lam, state.fnode, state.ud, state.td
     va, wa, db = hist.va, hist.wa, hist.db
     N = u.shape[0] - 1
@@ -514,131 +393,6 @@ def advance_explicit(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, driv
     return t, steps
 
 
-# ---------------------------------------------------------------------------
-# von Neumann analysis
-
-
-def _gyro_symbol(c, h, kh):
-    """G over the lumped mass on a uniform grid (1/s), for the mode e^{i kh j}."""
-    return 2.0 * c * (1.0 - np.exp(-1j * kh)) / h
-
-
-def _transport_symbol(c, h, kh):
-    """c d/dx of the slip velocity on a uniform grid (1/s), for the mode e^{i kh j}: the
-    model's stencil (physics.model.contact_stencil) read at an inner contact node of a
-    uniform grid: (3 - 4 e^{-i kh} + e^{-2 i kh}) / (2 h)."""
-    _, _, sw = contact_stencil(h * np.arange(8.0), 2, 6)
-    return c * sum(sw[4, o] * np.exp(1j * kh * (o - 2)) for o in range(3))
-
-
-def _amplification_matrices(params, h, dt, damping, kh, z):
-    """Amplification matrices (..., 5, 5) of one step on a uniform grid of elements h.
-
-    The state (u, theta, v_a, w_a, delta_b of the last kick) of the mode e^{i kh j},
-    every node in contact with a friction law of slope k, z = dt k (1/rho + (h/2)^2 / I);
-    kh and z broadcast against each other.
-    """
-    P = params
-    rho, rot, c, hh = P.rho, P.I, P.c, 0.5 * P.h
-    kh, z = np.broadcast_arrays(np.asarray(kh, float), np.asarray(z, float))
-    trap = (2.0 / dt) / (2.0 / dt + damping + _gyro_symbol(c, h, kh))  # vm = trap v_a
-    lap = -(2.0 - 2.0 * np.cos(kh)) / h**2
-    up = dt * _transport_symbol(c, h, kh)  # c dt D (the slip velocity's transport)
-    kb = 1.0 / rho + hh * hh / rot
-    a = A_EST + ALPHA * up
-    cols = []
-    for col in range(5):
-        u, th, va, wa, dp = (1.0 if i == col else 0.0 for i in range(5))
-        vm, wm = trap * va, trap * wa
-        vb, wb = 2.0 * vm - va, 2.0 * wm - wa
-        u1, t1 = u + dt * vm, th + dt * wm
-        eu = dt * (P.B / rho) * lap * u1
-        et = dt * ((P.A / rot) * lap - P.b2 / rot) * t1
-        eb = eu + hh * et
-        vrel = ((vb + hh * wb) - C_EST * dp + (up / dt) * (u1 + hh * t1) + a * eb) / (1.0 + a * z)
-        du = eu - z / (rho * kb) * vrel
-        dw = et - z * hh / (rot * kb) * vrel
-        cols.append(np.stack([u1, t1, vb + du, wb + dw, du + hh * dw], axis=-1))
-    return np.stack(cols, axis=-1)
-
-
-def _wave_amplification(params, h, dt, damping):
-    """Largest amplification without friction, in closed form (each field on its own).
-
-    Per field, in (u, dt v_a): [[1, tau], [q, 2 tau - 1 + q tau]] with q = -dt^2 omega^2,
-    tau = 1 / (1 + s) and s = (d + G) dt / 2; its eigenvalues
-    tau ((1 + q/2) +- sqrt(s^2 + q + q^2/4)) carry no cancellation at small dt.
-    """
-    P = params
-    kh = np.linspace(np.pi / 4096, np.pi, 4096)
-    s = 0.5 * dt * (damping + _gyro_symbol(P.c, h, kh))
-    tau = 1.0 / (1.0 + s)
-    worst = 0.0
-    for stiff, inertia, spring in ((P.B, P.rho, 0.0), (P.A, P.I, P.b2)):
-        q = -dt * dt * ((stiff / inertia) * (2.0 - 2.0 * np.cos(kh)) / h**2 + spring / inertia)
-        root = np.sqrt(s * s + q + 0.25 * q * q + 0j)
-        lam = np.maximum(np.abs(1.0 + 0.5 * q + root), np.abs(1.0 + 0.5 * q - root))
-        worst = max(worst, float((np.abs(tau) * lam).max()))
-    return worst
-
-
-def _coupled_amplification(params, h, dt, damping):
-    """Largest amplification with friction: all slopes of FRICTION_Z, both fields coupled."""
-    kh = np.linspace(np.pi / 96, np.pi, 96)
-    G = _amplification_matrices(params, h, dt, damping, kh[None, :], FRICTION_Z[:, None])
-    return float(np.abs(np.linalg.eigvals(G)).max())
-
-
-def explicit_amplification(params, h, dt, damping):
-    """Largest von Neumann amplification of the explicit scheme on elements of size h.
-
-    Both fields with their gyroscopic, damping, stiffness and shear terms, and friction
-    at every slope of FRICTION_Z with its velocity estimate and the transport of the
-    slip velocity (the stick limit included).
-    """
-    return max(_wave_amplification(params, h, dt, damping),
-               _coupled_amplification(params, h, dt, damping))
-
-
-@lru_cache(maxsize=256)
-def _stable_dt(B, A, b2, rho, rot, c, height, h_min, damping):
-    P = SimpleNamespace(B=B, A=A, b2=b2, rho=rho, I=rot, c=c, h=height)
-    # the stiffness terms' limit, in closed form, by bisection
-    w2 = max(4.0 * B / (rho * h_min**2), 4.0 * A / (rot * h_min**2) + b2 / rot)
-    lo, hi = 0.0, 4.0 / math.sqrt(w2)  # twice the leapfrog's 2 / omega_max
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if _wave_amplification(P, h_min, mid, damping) <= 1.0 + TOL:
-            lo = mid
-        else:
-            hi = mid
-    wave = lo
-    # friction can lower it (modes it couples weakly near the waves' limit): the first
-    # stable fraction of it, refined between that and the last unstable one
-    unstable = wave
-    for frac in (1.0, 0.999, 0.99, 0.97, 0.9, 0.8, 0.65, 0.5, 0.35, 0.2, 0.1, 0.05):
-        stable = frac * wave
-        if _coupled_amplification(P, h_min, stable, damping) <= 1.0 + TOL:
-            break
-        unstable = stable
-    else:
-        return 0.0
-    for _ in range(4 if unstable > stable else 0):
-        mid = 0.5 * (stable + unstable)
-        if _coupled_amplification(P, h_min, mid, damping) <= 1.0 + TOL:
-            stable = mid
-        else:
-            unstable = mid
-    return stable
-
-
-def explicit_stable_dt(params, h_min, damping):
-    """The largest step with amplification <= 1 on the smallest element; 0 when none is."""
-    P = params
-    return _stable_dt(float(P.B), float(P.A), float(P.b2), float(P.rho), float(P.I),
-                      float(P.c), float(P.h), float(h_min), float(damping))
-
-
 def _duration(seconds: float) -> str:
     for unit, size in (("days", 86400.0), ("hours", 3600.0), ("minutes", 60.0)):
         if seconds >= 2 * size:
@@ -652,13 +406,20 @@ class ExplicitScheme(Scheme):
     of the von Neumann limit (inertial scenes)."""
 
     name = "explicit"
-    closed = False  # open layouts only, for now
     needs_inertia = True
 
     def __init__(self, disc):
         super().__init__(disc)
         P, num, grid = disc.params, self.numerics, disc.grid
-        limit = explicit_stable_dt(P, grid.h_min, disc.model.damping)
+        if disc.closed:
+            from ..beltdrive.scene import max_rim_speed
+
+            speed = max_rim_speed(disc.scene.to_dict())  # c stays below it
+            limit = loop_stable_dt(P, grid.h_min, disc.model.damping, speed)
+            where = f"at belt speeds 0 .. {speed:.4g} m/s, "
+        else:
+            limit = explicit_stable_dt(P, grid.h_min, disc.model.damping)
+            where = ""
         if not limit > 0.0:
             raise SceneError("numerics.integrator", "the explicit scheme has no stable step "
                              "for this scene; use the implicit integrator")
@@ -666,20 +427,23 @@ class ExplicitScheme(Scheme):
         if requested is not None and requested > limit:
             raise SceneError(
                 "numerics.dt", f"{requested:.6g} s exceeds the explicit stability limit "
-                f"{limit:.6g} s (von Neumann, on the smallest element, {grid.h_min:.3g} m: "
-                f"the waves of both fields with the shear, gyroscopic and friction terms)")
+                f"{limit:.6g} s (von Neumann, on the smallest element, {grid.h_min:.3g} m, "
+                f"{where}the waves of both fields with the shear, gyroscopic and friction "
+                f"terms)")
         dt = requested if requested is not None else EXPLICIT_SAFETY * limit
         steps = math.ceil(num.t_end / dt)
-        work = steps * (grid.n_elements + 1.0)
+        nodes = len(disc.mesh.hb)
+        work = steps * float(nodes)
+        rate = EXPLICIT_LOOP_RATE if disc.closed else EXPLICIT_RATE
         if work > num.max_work:
             raise SceneError(
                 "numerics.max_work", f"this explicit run may need {work:.3g} node-steps "
                 f"({steps:.3g} steps of {dt:.3g} s to t_end = {num.t_end:.4g} s, "
-                f"{grid.n_elements + 1} nodes; about {_duration(work / EXPLICIT_RATE)} at "
-                f"{EXPLICIT_RATE:.0e} node-steps/s), above max_work = {num.max_work:.3g}; "
+                f"{nodes} nodes; about {_duration(work / rate)} at "
+                f"{rate:.0e} node-steps/s), above max_work = {num.max_work:.3g}; "
                 f'use numerics.integrator = "implicit", or raise numerics.max_work')
         self.numerics = dataclasses.replace(num, dt=dt)
-        self.hist = History.zeros(grid.n_elements + 1)
+        self.hist = History.zeros(nodes, disc.n_globals)
         self.hist_at = (math.nan, math.nan)  # the (t, dt) the history belongs to
 
     @property
@@ -688,7 +452,8 @@ class ExplicitScheme(Scheme):
 
     def _compile(self, state) -> None:
         # on copies: a resumed run's history must survive the warm-up
-        self._kernel(state.copy(), History.zeros(len(state.u)), True, 0.0, 0.0, 0)
+        self._kernel(state.copy(), History.zeros(len(state.u), len(state.g)), True, 0.0, 0.0,
+                     0)
 
     def _kernel(self, state, hist, fresh, t, t_stop, max_steps):
         d = self.disc
@@ -715,4 +480,5 @@ class ExplicitScheme(Scheme):
             return
         self.hist_at = tuple(float(v) for v in data["hist_at"])
         for k, a in zip(History._fields, self.hist):
-            a[:] = data[f"hist_{k}"]
+            if f"hist_{k}" in data:  # an open layout's checkpoint has no loop fields
+                a[:] = data[f"hist_{k}"]

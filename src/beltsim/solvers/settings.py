@@ -62,6 +62,7 @@ FIRST_STEPS = 50.0
 MIN_MISMATCH = 1e-8  # smallest nonzero |v/c - 1| a run accepts
 DEFAULT_MAX_WORK = 2e10  # node-steps of an explicit run
 EXPLICIT_RATE = 8e7  # node-steps per second of the explicit kernel (bench), for messages
+EXPLICIT_LOOP_RATE = 2e7  # the same on a loop (drive_flat, 800 elements: 2.0-2.6e7)
 MEMORY_PER_NODE = 600  # bytes a grid node costs a run at its peak
 MIN_REGULARISATION = 1e-12  # smallest regularisation velocity, relative to c
 DEFAULT_ADHESION_LAYER = 1e-6  # delta / L
@@ -294,6 +295,9 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
     t_end = nm.get("t_end", settle + LOOP_END_TRANSITS * transit)
     if dt > t_end:
         raise SceneError("numerics.dt", f"must be <= numerics.t_end = {t_end!r}, got {dt!r}")
+    if "max_work" in nm and integrator != "explicit":
+        raise SceneError("numerics.max_work", 'only for numerics.integrator = "explicit" (the '
+                         "other schemes' steps adapt)")
     creep = creep_speed(P)
     # the lowest string frequency of the longer free span (pi sqrt(N0 / rho) / l)
     omega1 = math.pi * math.sqrt(P.N0 / P.rho) / max(P.geometry.lengths[1::2]) \
@@ -317,4 +321,5 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
         newton_tol=nm.get("newton_tol", 1e-9),
         newton_max_iterations=newton_iterations(nm, law),
         time_tol=nm.get("time_tol", LOOP_TIME_TOLS.get(integrator, DEFAULT_TIME_TOL)),
-        settle_time=settle, gyroscopic=nm.get("gyroscopic", "upwind"))
+        settle_time=settle, max_work=nm.get("max_work", DEFAULT_MAX_WORK),
+        gyroscopic=nm.get("gyroscopic", "upwind"))
