@@ -99,10 +99,13 @@ def write_checkpoint(path, sim) -> Path:
 
 
 def read_checkpoint(path) -> dict:
-    """The parts of :func:`write_checkpoint`: scene, t, wall_time, state, scheme, trackers."""
+    """The parts of :func:`write_checkpoint`: scene (of either kind), t, wall_time, state,
+    scheme, trackers."""
+    from ..api import scene_from_tables
+
     try:
         with np.load(path) as z:
-            scene = Scene(tomllib.loads(str(z["scene"])))
+            scene = scene_from_tables(tomllib.loads(str(z["scene"])))
             out = {"scene": scene, "t": float(z["t"]), "wall_time": float(z["wall_time"]),
                    "state": {}, "scheme": {}, "trackers": {}}
             for key in z.files:
