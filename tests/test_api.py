@@ -402,3 +402,31 @@ def test_a_steady_solve_starts_and_ends_the_trackers():
         elements=60, integrator="steady")), trackers=[log])
     assert result.converged and log.status is RunStatus.CONVERGED and log.t == []
     assert math.isfinite(result.solution.total_friction)
+
+
+class TimeLog(Tracker):
+    """Records the time of every check and the status the run ended in."""
+
+    def __init__(self):
+        self.t, self.status = [], None
+
+    def handle(self, sim):
+        self.t.append(sim.t)
+
+    def finalize(self, sim, status):
+        self.status = status
+
+
+@pytest.mark.parametrize("name, elements", [("paper_slip", 60), ("drive_flat", 100)])
+def test_user_trackers_see_and_stop_either_layout(name, elements):
+    """The same tracker on both layouts: it sees every check of a run (the run's own
+    history has the same times) and its Stop ends a run at the first check past it."""
+    scene = beltsim.load_scene(name, {"numerics.elements": elements})
+    log = TimeLog()
+    result = beltsim.run(scene, trackers=[log])
+    assert result.converged and log.status is RunStatus.CONVERGED
+    np.testing.assert_array_equal(log.t, result.history["t"])
+    stop_at = 0.25 * result.simulated_time
+    cut = beltsim.run(scene, trackers=[StopAt(stop_at)])
+    assert cut.status is RunStatus.INTERRUPTED and cut.simulated_time >= stop_at
+    assert cut.reason == f"enough at t = {cut.simulated_time:.4g} s"
