@@ -268,7 +268,7 @@ def test_gross_slip_threshold():
 # the command line ------------------------------------------------------------------
 
 @pytest.mark.cli
-def test_cli_runs_and_refuses_drives(tmp_path):
+def test_cli_runs_drives_and_refuses_bad_ones(tmp_path):
     res = cli("analytic", "drive_flat", "--set", "physics.model=string", "--out",
               tmp_path / "a")
     assert res.returncode == 0, res.stderr
@@ -277,8 +277,14 @@ def test_cli_runs_and_refuses_drives(tmp_path):
               tmp_path / "b")
     assert res.returncode == 2 and res.stderr.count("\n") == 1
     assert "drive.centre_distance" in res.stderr
-    res = cli("convergence", "drive_flat")
-    assert res.returncode == 2 and "closed drive" in res.stderr
+    # the convergence study on a drive: its own errors, observed orders; Richardson's
+    # extrapolation (a straight belt's bisected grid) is refused in one line
+    res = cli("convergence", "drive_flat", "--ladder", "100,200", "--schemes", "steady",
+              "--out", tmp_path / "c")
+    assert res.returncode == 0, res.stderr
+    assert "tight_tension" in res.stdout and (tmp_path / "c" / "convergence.csv").is_file()
+    res = cli("convergence", "drive_flat", "--schemes", "richardson")
+    assert res.returncode == 2 and res.stderr.count("\n") == 1 and "--schemes" in res.stderr
     # a torque sweep past the capacity (98.4 N m): gross slip is no steady state, exit 1
     # as 'beltsim run' gives (outputs.md, exit statuses), with every output written
     res = cli("sweep", "drive_flat", "--set", "physics.model=string", "--vary",

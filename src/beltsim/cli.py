@@ -35,14 +35,6 @@ def _scene(args):
     return load_scene(args.scene, args.overrides)
 
 
-def _straight_only(args, scene):
-    """Refuse, in one line, a closed drive in a command that knows only straight belts."""
-    if is_drive_scene(scene):
-        raise UsageError(f"{args.command}: not available for a closed drive yet (use "
-                         f"'beltsim run' or 'beltsim analytic')")
-    return scene
-
-
 def _drive_analytic(args, scene):
     from .api import solve
     from .beltdrive.io import format_drive
@@ -163,16 +155,17 @@ def cmd_convergence(args):
     from .plots.studies import ERROR_VS_RUNTIME_DPI, error_vs_runtime
     from .studies import convergence as studies
 
-    scene = _straight_only(args, _scene(args))
+    scene = _scene(args)
     ladder = _int_list(args.ladder, "--ladder")
     schemes = args.schemes.split(",") if args.schemes else None
-    known = (*solvers.names(), studies.RICHARDSON)
+    known = (*solvers.names(), *(() if is_drive_scene(scene) else (studies.RICHARDSON,)))
     for s in schemes or ():
         if s not in known:
             raise UsageError(f"--schemes: unknown scheme {s!r} ({', '.join(known)})")
     out = prepare_outdir(args.out or Path("runs/out") / f"convergence_{Path(args.scene).stem}")
+    keys = studies.error_keys(scene)
     cols = ("scheme", "elements", "h_min", "dt", "steps", "wall_time", "compile_time",
-            "converged") + tuple(f"error_{k}" for k in studies.ERROR_KEYS)
+            "converged") + tuple(f"error_{k}" for k in keys)
     print("  ".join(f"{c:>12s}" for c in cols))
 
     def show(row):
@@ -185,7 +178,7 @@ def cmd_convergence(args):
     save_figure(error_vs_runtime, out / "error_vs_runtime.png", rows,
                 title=f"{scene.title or args.scene}", dpi=ERROR_VS_RUNTIME_DPI)
     print("observed order in the grid size (successive grids; least-squares fit):")
-    for key in studies.ERROR_KEYS:
+    for key in keys:
         for scheme, o in studies.observed_orders(rows, key).items():
             pairs = ", ".join(f"{p:.2f}" for p in o["pairs"])
             print(f"  {key:<20s} {scheme:<9s} {pairs}  (fit {o['fit']:.2f})")
@@ -200,7 +193,7 @@ def cmd_bench(args):
     from .studies import bench as studies
 
     grid = [("numerics.elements", args.elements)] if args.elements is not None else []
-    scene = _straight_only(args, load_scene(args.scene, [*args.overrides, *grid]))
+    scene = load_scene(args.scene, [*args.overrides, *grid])
     result = studies.bench(scene, cold=not args.no_cold, repeat=args.repeat)
     print(studies.bench_json(result))
     return 0

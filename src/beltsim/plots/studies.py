@@ -20,14 +20,14 @@ SCHEME_STYLE = {"explicit": ("tab:red", "s"), "implicit": ("tab:blue", "o"),
 
 
 def error_vs_runtime(rows, title="", ax=None):
-    """Log-log error of the total friction against wall time, one line per scheme.
+    """Log-log error against wall time, one line per scheme: the total friction's of a
+    straight belt, the tight span tension's of a drive (the rows' first error).
 
     Parameters
     ----------
     rows : list of dict
         The rows of :func:`beltsim.studies.convergence.convergence` (scheme, elements,
-        wall_time, converged, error_total_friction); rows that did not converge are
-        left out.
+        wall_time, converged and the errors); rows that did not converge are left out.
     title : str, optional
         The axes' title (the scene's, typically).
     ax : Axes, optional
@@ -38,17 +38,19 @@ def error_vs_runtime(rows, title="", ax=None):
     matplotlib.figure.Figure
     """
     fig, (ax,), _ = panel_axes(ax, 1, figsize=(6.4, 4.6))
+    key = next((k for k in rows[0] if k.startswith("error_")), "error_total_friction") \
+        if rows else "error_total_friction"
     for scheme in dict.fromkeys(r["scheme"] for r in rows):
         rs = [r for r in rows if r["scheme"] == scheme and r["converged"]]
         t = np.array([r["wall_time"] for r in rs])
-        e = np.array([r["error_total_friction"] for r in rs])
+        e = np.array([abs(r[key]) for r in rs])
         color, marker = SCHEME_STYLE.get(scheme, ("k", "x"))
         ax.loglog(t, e, marker=marker, color=color, label=scheme)
         for r, ti, ei in zip(rs, t, e):
             ax.annotate(f"{r['elements']}", (ti, ei), textcoords="offset points",
                         xytext=(4, 4), fontsize=7, color=color)
     ax.set_xlabel("wall time to steady state [s] (numba compilation excluded)")
-    ax.set_ylabel("relative error of the total friction")
+    ax.set_ylabel(f"relative error of the {key[6:].replace('_', ' ')}")
     ax.set_title(textwrap.fill(f"{title} (labels: elements)" if title else
                                "Error against run time (labels: elements)", 70), fontsize=10)
     ax.grid(True, which="both", alpha=0.3)

@@ -69,7 +69,12 @@ class Readout:
 
     def reference(self):
         """The exact steady solution of the scene, or None."""
-        return reference_of(self.disc.scene)
+        return self.exact(self.disc.scene)
+
+    @staticmethod
+    def exact(scene):
+        """The exact steady solution of a scene of this layout, or None."""
+        return reference_of(scene)
 
     @staticmethod
     def discrete_reference(solution):
@@ -132,12 +137,12 @@ class LoopReadout(Readout):
                 f"driven pulley slows down ({sim.state.g[1]:.6g} rad/s)")
         return None
 
-    def reference(self):
+    @staticmethod
+    def exact(scene):
         """The drive's exact steady state (the string's or the beam's, as the scene's
         model), or None: a periodic drive, or a load beyond the capacity."""
         from ..beltdrive.beam import exact_state
 
-        scene = self.disc.scene
         if any(isinstance(scene.drive[k], dict) for k in ("driver_speed", "load_torque")):
             return None  # a periodic drive never settles
         P = scene.params

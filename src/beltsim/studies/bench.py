@@ -16,10 +16,12 @@ import sys
 import tempfile
 import time
 
+from ..api import is_drive_scene
 from ..problem.scene import Scene
 from ..simulation.controller import Simulation
-from ..simulation.result import reference_of
+from ..simulation.readout import readout_class
 from ..simulation.solution import relative_error
+from .convergence import error_keys
 
 
 def explicit_node_steps_per_s(scene: Scene, settle=0.05, span=0.02) -> float:
@@ -70,36 +72,41 @@ def run_ours(scene: Scene, repeat=3, log=print) -> tuple[dict, object, object]:
 
     Returns the ``ours_*`` entries of :func:`bench` and the two RunResults.
     """
-    exact = reference_of(scene).total_friction
+    key = error_keys(scene)[0]  # the total friction; a drive's tight span tension
+    exact = readout_class(is_drive_scene(scene)).exact(scene).summary()[key]
     res = _ours(scene, repeat)
-    total = res.solution.total_friction
-    out = {"elements": res.solution.grid.n_elements, "ours_integrator": res.numerics.integrator,
-           "ours_wall_time": res.wall_time,
-           "ours_error": relative_error(total, exact), "ours_converged": res.converged,
-           "ours_steps": res.steps, "ours_total_friction": total}
+    value = res.summary()[key]
+    out = {"elements": res.numerics.elements, "ours_integrator": res.numerics.integrator,
+           "figure": key, "ours_wall_time": res.wall_time,
+           "ours_error": relative_error(value, exact), "ours_converged": res.converged,
+           "ours_steps": res.steps, f"ours_{key}": value}
+    name = key.replace("_", " ")
     log(f"ours   ({res.numerics.integrator}, {out['elements']} elements): "
-        f"{res.steps} steps, wall {res.wall_time:.4f} s, total "
-        f"friction {total:.8g} N, error {out['ours_error']:.2e} (compile/cache load "
-        f"{res.compile_time:.2f} s, not counted)")
+        f"{res.steps} steps, wall {res.wall_time:.4f} s, {name} {value:.8g} N, error "
+        f"{out['ours_error']:.2e} (compile/cache load {res.compile_time:.2f} s, not counted)")
     steady = _ours(scene.with_overrides([("numerics.integrator", "steady")]), repeat)
-    out.update(ours_steady_wall_time=steady.wall_time,
-               ours_steady_total_friction=steady.solution.total_friction,
-               ours_steady_error=relative_error(steady.solution.total_friction, exact))
-    log(f"ours   (steady): wall {steady.wall_time:.4f} s, total friction "
-        f"{steady.solution.total_friction:.8g} N, error {out['ours_steady_error']:.2e}")
+    value = steady.summary()[key]
+    out.update({"ours_steady_wall_time": steady.wall_time, f"ours_steady_{key}": value,
+                "ours_steady_error": relative_error(value, exact)})
+    log(f"ours   (steady): wall {steady.wall_time:.4f} s, {name} {value:.8g} N, error "
+        f"{out['ours_steady_error']:.2e}")
     return out, res, steady
 
 
 def bench(scene: Scene, cold=True, repeat=3, log=print) -> dict:
-    """The default run, the steady scheme, the explicit kernel's speed and a cold start.
+    """The default run, the steady scheme, the explicit kernel's speed and a cold start,
+    of a straight belt or a drive.
 
-    Keys: ``elements``, ``ours_*`` (the scene's scheme, the default run), ``ours_steady_*``
+    Keys: ``elements``, ``figure`` (what the errors are of: the total friction, a drive's
+    tight span tension), ``ours_*`` (the scene's scheme, the default run), ``ours_steady_*``
     (the steady scheme), ``explicit_node_steps_per_s`` and ``cold_start_time`` (a fresh
     process with an empty numba cache, run to steady state; None when ``cold`` is false).
     """
     out, _, _ = run_ours(scene, repeat, log)
-    out["explicit_node_steps_per_s"] = explicit_node_steps_per_s(scene)
-    log(f"explicit kernel: {out['explicit_node_steps_per_s']:.3g} node-steps/s")
+    out["explicit_node_steps_per_s"] = (explicit_node_steps_per_s(scene)
+                                        if scene.params.inertia else None)
+    if out["explicit_node_steps_per_s"] is not None:
+        log(f"explicit kernel: {out['explicit_node_steps_per_s']:.3g} node-steps/s")
     out["cold_start_time"] = None
     if cold:
         out["cold_start_time"] = cold_start_time(scene)

@@ -9,11 +9,12 @@ from __future__ import annotations
 import numpy as np
 
 from .. import solvers
+from ..api import is_drive_scene
 from ..errors import SceneError
 from ..physics.grid import bisect
 from ..problem.scene import Scene
 from ..simulation.controller import Simulation
-from ..simulation.readout import Readout
+from ..simulation.readout import Readout, readout_class
 from ..simulation.result import reference_of
 from ..simulation.solution import DiscreteSolution, compare, relative_error
 
@@ -22,11 +23,18 @@ ERROR_KEYS = Readout.error_keys  # the open layout's
 RICHARDSON = "richardson"  # the extrapolated steady scheme, a study rather than a scheme
 
 
-def schemes_for(scene: Scene) -> tuple[str, ...]:
-    """The registered schemes that apply to a scene, then Richardson's extrapolation."""
-    inertia = scene.params.inertia
-    return tuple(n for n in solvers.names() if solvers.applicable(n, inertia) is None) + (
-        RICHARDSON,)
+def schemes_for(scene) -> tuple[str, ...]:
+    """The registered schemes that apply to a scene, then Richardson's extrapolation (a
+    straight belt's: it extrapolates on a bisected open grid)."""
+    inertia, closed = scene.params.inertia, is_drive_scene(scene)
+    return tuple(n for n in solvers.names()
+                 if solvers.applicable(n, inertia, closed) is None) + (
+        () if closed else (RICHARDSON,))
+
+
+def error_keys(scene) -> tuple[str, ...]:
+    """The errors a study reports for a scene's layout (its readout's)."""
+    return readout_class(is_drive_scene(scene)).error_keys
 
 
 def richardson(scene: Scene, reference=None):
@@ -65,51 +73,57 @@ def richardson(scene: Scene, reference=None):
 
 
 def _row(scheme, elements, h_min, dt, steps, newton_iterations, wall_time, compile_time,
-         converged, err, reason=""):
+         converged, err, keys, reason=""):
     err = err or {}
     return {"scheme": scheme, "elements": elements, "h_min": h_min, "dt": dt, "steps": steps,
             "newton_iterations": newton_iterations, "wall_time": wall_time,
             "compile_time": compile_time, "converged": converged,
             **{f"error_{k}": err[k] if err.get(k) is not None else float("nan")
-               for k in ERROR_KEYS}, "reason": reason}
+               for k in keys}, "reason": reason}
 
 
-def convergence(scene: Scene, ladder=LADDER, schemes=None, progress=None) -> list[dict]:
+def convergence(scene, ladder=LADDER, schemes=None, progress=None) -> list[dict]:
     """Run each scheme on each grid of the ladder; one row per run.
 
-    A rung refused before running (a SceneError, e.g. the explicit scheme's
-    numerics.max_work on a fine grid) is a row that did not converge, with the refusal
-    as its reason: the rest of the ladder still runs and reports.
+    ``scene`` is a straight belt or a closed drive; each row carries its layout's errors
+    (:func:`error_keys`) against the exact steady state. A rung refused before running
+    (a SceneError, e.g. the explicit scheme's numerics.max_work on a fine grid) is a row
+    that did not converge, with the refusal as its reason: the rest of the ladder still
+    runs and reports.
     """
     rows = []
-    reference = reference_of(scene)
+    keys = error_keys(scene)
+    reference = readout_class(is_drive_scene(scene)).exact(scene)
     nan = float("nan")
     for scheme in schemes or schemes_for(scene):
         for n in ladder:
             sc = scene.with_overrides([("numerics.elements", n)])
             try:
-                row = _rung(sc, scheme, n, reference)
+                row = _rung(sc, scheme, n, reference, keys)
             except SceneError as exc:
-                row = _row(scheme, n, nan, nan, 0, 0, nan, nan, False, None, str(exc))
+                row = _row(scheme, n, nan, nan, 0, 0, nan, nan, False, None, keys, str(exc))
             rows.append(row)
             if progress:
                 progress(row)
     return rows
 
 
-def _rung(sc, scheme, n, reference) -> dict:
+def _rung(sc, scheme, n, reference, keys) -> dict:
     """One scheme on one grid of the ladder."""
     if scheme == RICHARDSON:
+        if is_drive_scene(sc):
+            raise SceneError("--schemes", "richardson extrapolates a straight belt's "
+                             "bisected grid; a drive has none")
         r1, r2, err, wall = richardson(sc, reference)
         return _row(scheme, n, r1.solution.grid.h_min, float("nan"), r1.steps + r2.steps,
                     r1.newton_iterations + r2.newton_iterations, wall,
-                    r1.compile_time + r2.compile_time, err is not None, err)
+                    r1.compile_time + r2.compile_time, err is not None, err, keys)
     sim = Simulation(sc.with_overrides([("numerics.integrator", scheme)]))
     res = sim.run(raise_on_failure=False)
     res.reference = reference
     dt = sim.numerics.dt if sim.scheme.transient else float("nan")
     return _row(scheme, n, sim.grid.h_min, dt, res.steps, res.newton_iterations,
-                res.wall_time, res.compile_time, res.converged, res.errors())
+                res.wall_time, res.compile_time, res.converged, res.errors(), keys)
 
 
 def observed_orders(rows, key) -> dict:
@@ -118,7 +132,7 @@ def observed_orders(rows, key) -> dict:
     for scheme in dict.fromkeys(r["scheme"] for r in rows):
         rs = [r for r in rows if r["scheme"] == scheme and r["converged"]]
         h = np.array([r["h_min"] for r in rs])
-        e = np.array([r[f"error_{key}"] for r in rs])
+        e = np.abs(np.array([r[f"error_{key}"] for r in rs]))  # a drive's are signed
         ok = np.isfinite(e) & (e > 0)
         h, e = h[ok], e[ok]
         if len(e) < 2:
