@@ -23,7 +23,7 @@ import numpy as np
 
 import beltsim
 from beltsim import beltdrive
-from beltsim.beltdrive import plots
+from beltsim.beltdrive.characteristic import plot_characteristic
 
 scene = beltsim.load_scene("drive_flat")
 P = scene.params
@@ -61,7 +61,7 @@ print(f"load ramped to {1.1 * cap:.1f} N m: {slow.status.value}, {slow.reason}")
 # (cross). There the driven pulley slows down and gives up kinetic energy to the load, so
 # the momentary ratio of output to input power rises: a transient, not an efficiency.
 
-fig = plots.plot_characteristic(loads, np.array(loss), np.array(eff), capacity=cap,
+fig = plot_characteristic(loads, np.array(loss), np.array(eff), capacity=cap,
                                 analytic=analytic)
 h = slow.history
 on = h["t"] > 0.5  # up to speed: the efficiency of a start-up is not a characteristic

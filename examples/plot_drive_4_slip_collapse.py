@@ -21,7 +21,7 @@ from scipy.optimize import brentq
 
 import beltsim
 from beltsim import beltdrive
-from beltsim.beltdrive import plots
+from beltsim.beltdrive.characteristic import plot_slip_collapse
 
 scene = beltsim.load_scene("drive_flat", [("physics.model", "string")])
 P = scene.params
@@ -65,7 +65,7 @@ print(f"perfect adhesion: tight tension {adhesion.T1:.2f} N, concentrated forces
 # limits. The driver's and the driven pulley's markers lie on one analytic curve: the
 # slip arc does not depend on the pulley's radius.
 
-fig = plots.plot_slip_collapse(mus, driver, driven, wraps=g.wraps,
+fig = plot_slip_collapse(mus, driver, driven, wraps=g.wraps,
                                analytic={"driver": phi_s, "driven": phi_s})
 plt.show()
 

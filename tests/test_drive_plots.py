@@ -12,14 +12,13 @@ from PIL import Image
 
 from beltsim.beltdrive import plots
 from beltsim.beltdrive.analytic import capacity, solve_string
+from beltsim.beltdrive.characteristic import plot_characteristic, plot_slip_collapse
 from beltsim.beltdrive.plots import (
     _slip_runs,
     animate_drive,
     draw_drive,
-    plot_characteristic,
     plot_drive_history,
     plot_loop_fields,
-    plot_slip_collapse,
 )
 from beltsim.beltdrive.scene import DriveScene
 from beltsim.plots.common import offscreen, save_figure

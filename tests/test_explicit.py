@@ -24,6 +24,7 @@ from beltsim.solvers.explicit import (
     ALPHA,
     C_EST,
     EXPLICIT_SAFETY,
+    LOOP_SAFETY,
     History,
     _friction_scalar,
     _law,
@@ -60,7 +61,10 @@ def _steps(d, state, hist, fresh, t, dt, n):
 @pytest.mark.parametrize("name", ["paper_inertia", "drive_flat"])
 def test_requested_step_above_the_explicit_limit_is_refused(name):
     sim = Simulation(_scene(name, "numerics.integrator=explicit"))
-    limit = sim.numerics.dt / EXPLICIT_SAFETY
+    limit = _limit(sim.disc)
+    # the default step: a fraction of the limit, a loop's smaller (LOOP_SAFETY)
+    assert sim.numerics.dt == pytest.approx(
+        (LOOP_SAFETY if sim.disc.closed else EXPLICIT_SAFETY) * limit, rel=1e-15)
     with pytest.raises(beltsim.SceneError, match=r"^numerics\.dt: .* exceeds the explicit"):
         Simulation(_scene(name, "numerics.integrator=explicit", f"numerics.dt={1.01 * limit}"))
     Simulation(_scene(name, "numerics.integrator=explicit", f"numerics.dt={0.99 * limit}"))

@@ -275,7 +275,7 @@ def _drive_sweep(args, scene, key, values):
 
     import numpy as np
 
-    from .beltdrive import plots
+    from .beltdrive.characteristic import plot_characteristic
     from .io.files import prepare_outdir, write_csv
     from .plots.common import save_figure
     from .simulation.loop_solution import SUMMARY_KEYS
@@ -298,7 +298,7 @@ def _drive_sweep(args, scene, key, values):
     if key == "drive.load_torque":
         ok = [r for r in rows if r["converged"]]
         fig = save_figure(
-            plots.plot_characteristic, out / "characteristic.png",
+            plot_characteristic, out / "characteristic.png",
             [r["value"] for r in ok], [1.0 - r["speed_ratio"] for r in ok],
             [r["efficiency"] for r in ok], capacity=rows[0]["capacity"],
             analytic={"speed_loss": [1.0 - r["speed_ratio_analytic"] for r in ok],

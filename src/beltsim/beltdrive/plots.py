@@ -1,5 +1,6 @@
-"""Pictures of a closed belt drive: the drive to scale, its fields along the loop, its
-history, its characteristic curve and its slip arcs against mu.
+"""Pictures of a closed belt drive: the drive to scale, its fields along the loop and its
+history (its characteristic curve and its slip arcs against mu:
+:mod:`beltsim.beltdrive.characteristic`).
 
 Every function works on plain arrays, so that a simulation's results and the analytic
 steady states (:func:`beltsim.beltdrive.analytic.solve_string`) draw alike: ``x`` holds
@@ -61,7 +62,7 @@ CURVE_SAMPLES = 201
 # input checks
 
 
-def _vector(name, values, n=None, per="node") -> np.ndarray:
+def vector(name, values, n=None, per="node") -> np.ndarray:
     """``values`` as a 1-D array of finite floats (``n`` of them, one per ``per``)."""
     try:
         a = np.asarray(values, dtype=float)
@@ -91,7 +92,7 @@ def _mask(name, values, n) -> np.ndarray:
 
 def _nodes(geometry, x) -> np.ndarray:
     """The loop's node coordinates: increasing in [0, Lambda), at least three."""
-    x = _vector("x", x)
+    x = vector("x", x)
     lam = geometry.loop_length
     if len(x) < 3:
         raise ValueError(f"x: needs at least 3 nodes on the loop, got {len(x)}")
@@ -103,14 +104,14 @@ def _nodes(geometry, x) -> np.ndarray:
     return x
 
 
-def _curve(name, spec, at, grid):
+def curve(name, spec, at, grid):
     """An analytic curve: a callable sampled on ``grid``, or an array beside ``at``."""
     if callable(spec):
         return grid, np.array([float(spec(v)) for v in grid])
-    return at, _vector(name, spec, len(at), "point")
+    return at, vector(name, spec, len(at), "point")
 
 
-def _analytic_parts(name, analytic, keys) -> dict:
+def analytic_parts(name, analytic, keys) -> dict:
     """The analytic curves given (a mapping with some of ``keys``)."""
     if analytic is None:
         return {}
@@ -204,7 +205,7 @@ class _DriveDrawing:
 
         names = ("driver", "driven")
         speeds = (None, None) if rim_speeds is None else tuple(
-            _vector("rim_speeds", rim_speeds, 2, "pulley"))
+            vector("rim_speeds", rim_speeds, 2, "pulley"))
         for (cx, R), name, v in zip(((0.0, R1), (C, R2)), names, speeds):
             ax.add_patch(Circle((cx, 0.0), R, facecolor="0.93", edgecolor="0.35", lw=1.2,
                                 zorder=1, gid=f"pulley {name}"))
@@ -321,12 +322,12 @@ def draw_drive(geometry, x, tension, slip=None, *, ax=None, title=None, rim_spee
     from matplotlib.colors import Normalize
 
     x = _nodes(geometry, x)
-    tension = _vector("tension", tension, len(x))
+    tension = vector("tension", tension, len(x))
     slip = None if slip is None else _mask("slip", slip, len(x))
     if tension_range is None:
         norm = _norm(tension.min(), tension.max())
     else:
-        lo, hi = _vector("tension_range", tension_range, 2, "limit")
+        lo, hi = vector("tension_range", tension_range, 2, "limit")
         if not hi > lo:
             raise ValueError(f"tension_range: must be (low, high) with low < high, got "
                              f"({lo:g}, {hi:g})")
@@ -395,7 +396,7 @@ def plot_loop_fields(x, fields, geometry, *, analytic=None, ax=None):
     panels = [(k, label) for k, label in LOOP_PANELS if k in fields]
     if not panels:
         raise ValueError("fields: needs 'tension' or 'friction' (nodal arrays)")
-    values = {k: _vector(f"fields[{k!r}]", fields[k], len(x)) for k, _ in panels}
+    values = {k: vector(f"fields[{k!r}]", fields[k], len(x)) for k, _ in panels}
     fig, axes, own = panel_axes(ax, len(panels), figsize=(9.0, 1.6 + 2.6 * len(panels)),
                                 sharex=True)
     lam, e = geometry.loop_length, geometry.bounds
@@ -469,7 +470,7 @@ def plot_drive_history(t, history, *, ax=None, steady=None):
         None of the keys above, arrays of other lengths than ``t``, or ``ax`` with another
         number of Axes than panels.
     """
-    t = _vector("t", t, per="time")
+    t = vector("t", t, per="time")
     if not isinstance(history, Mapping):
         raise ValueError(f"history: must be a mapping of names to arrays, got "
                          f"{type(history).__name__}")
@@ -486,7 +487,7 @@ def plot_drive_history(t, history, *, ax=None, steady=None):
     for ax_, (keys, label) in zip(axes, panels):
         for key in keys:
             name, color = HISTORY_LINES[key]
-            y = _vector(f"history[{key!r}]", history[key], len(t), "time")
+            y = vector(f"history[{key!r}]", history[key], len(t), "time")
             # a panel of one line is named by its axis; its legend tells only the styles
             ax_.plot(t, y, color=color, lw=1.6, marker=marker,
                      label=name if len(keys) > 1 else "history")
@@ -547,12 +548,12 @@ def animate_drive(geometry, x, frames, *, times, path, fps=20, dpi=80):
     frames = list(frames)
     if not frames:
         raise ValueError("frames: needs at least one frame")
-    times = _vector("times", times, len(frames), "frame")
+    times = vector("times", times, len(frames), "frame")
     tensions, slips, titles = [], [], []
     for k, frame in enumerate(frames):
         if not isinstance(frame, Mapping) or "tension" not in frame:
             raise ValueError(f"frames[{k}]: must be a mapping with a 'tension' array")
-        tensions.append(_vector(f"frames[{k}]['tension']", frame["tension"], len(x)))
+        tensions.append(vector(f"frames[{k}]['tension']", frame["tension"], len(x)))
         slip = frame.get("slip")
         slips.append(None if slip is None else _mask(f"frames[{k}]['slip']", slip, len(x)))
         text = f"t = {times[k]:.4g} s"
@@ -596,139 +597,4 @@ def animate_drive(geometry, x, frames, *, times, path, fps=20, dpi=80):
 # sweeps
 
 
-def plot_characteristic(loads, speed_loss, efficiency, *, capacity=None, analytic=None,
-                        ax=None):
-    """The drive's characteristic: speed loss and efficiency against the load torque.
-
-    Parameters
-    ----------
-    loads : array_like
-        Load torques M2 (N m).
-    speed_loss : array_like
-        1 - omega2 R2 / (omega1 R1) at each load (drawn in %).
-    efficiency : array_like
-        M2 omega2 / (M1 omega1) at each load (drawn in %).
-    capacity : float, optional
-        The largest load the drive carries (N m): a vertical line, gross slip beyond.
-    analytic : mapping, optional
-        ``"speed_loss"`` and/or ``"efficiency"``: callables of the load (sampled from 0 to
-        the largest load, or to just short of a finite capacity) or arrays beside
-        ``loads``; drawn as lines.
-    ax : sequence of two Axes, optional
-        Default a new figure.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-
-    Raises
-    ------
-    ValueError
-        Arrays of other lengths than ``loads``, an unknown analytic key, or ``ax`` with
-        another number of Axes than two.
-    """
-    loads = _vector("loads", loads, per="load")
-    data = {"speed_loss": _vector("speed_loss", speed_loss, len(loads), "load"),
-            "efficiency": _vector("efficiency", efficiency, len(loads), "load")}
-    exact = _analytic_parts("analytic", analytic, tuple(data))
-    finite_cap = capacity is not None and math.isfinite(capacity)
-    top = capacity if finite_cap else (loads.max() if len(loads) else 1.0)
-    # no steady state at or beyond the capacity: the curves stop just short of it
-    grid = np.linspace(0.0, top * (1 - 1e-6) if finite_cap else top, CURVE_SAMPLES)
-    fig, axes, own = panel_axes(ax, 2, figsize=(8.0, 6.5), sharex=True)
-    labels = {"speed_loss": "speed loss 1 − ω2R2 / ω1R1 [%]", "efficiency": "efficiency [%]"}
-    right = 1.05 * max(loads.max() if len(loads) else 0.0, capacity if finite_cap else 0.0)
-    for ax_, key in zip(axes, data):
-        if key in exact:
-            xs, ys = _curve(f"analytic[{key!r}]", exact[key], loads, grid)
-            ax_.plot(xs, 100 * ys, color="k", lw=1.2, label="analytic steady state")
-        ax_.plot(loads, 100 * data[key], "o", color=RUN_STYLE["color"], ms=5,
-                 label="simulation" if exact else None)
-        if finite_cap:
-            ax_.axvline(capacity, color="tab:red", ls="--", lw=1.2,
-                        label=f"capacity {capacity:.4g} N m")
-            ax_.axvspan(capacity, right, color="tab:red", alpha=0.08, lw=0,
-                        label="gross slip (no steady state)")
-        ax_.set_ylabel(labels[key], fontsize=9)
-        ax_.grid(True, alpha=0.3)
-    axes[0].legend(fontsize=8, loc="best")
-    if right > 0:
-        axes[-1].set_xlim(0.0, right)
-    axes[-1].set_xlabel("load torque M2 [N m]")
-    if own:
-        fig.suptitle("drive characteristic: speed loss and efficiency against load",
-                     fontsize=10)
-    return fig
-
-
-def plot_slip_collapse(mus, slip_arcs_driver, slip_arcs_driven, *, wraps=None,
-                       analytic=None, ax=None):
-    """The slip arcs on both pulleys against the friction coefficient mu (log scale).
-
-    As mu grows the slip arcs shrink onto the arcs' exits and the drive tends to perfect
-    adhesion; a slip arc reaching its wrap angle is gross slip.
-
-    Parameters
-    ----------
-    mus : array_like
-        Friction coefficients (> 0).
-    slip_arcs_driver, slip_arcs_driven : array_like
-        The slip arcs (rad) at each mu.
-    wraps : (float, float), optional
-        The wrap angles (rad) of the driver and the driven pulley, drawn as limits.
-    analytic : mapping, optional
-        ``"driver"`` and/or ``"driven"``: callables of mu (sampled over the range of
-        ``mus``) or arrays beside ``mus``; drawn as lines.
-    ax : Axes, optional
-        Default a new figure.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-
-    Raises
-    ------
-    ValueError
-        Arrays of other lengths than ``mus``, a mu <= 0, or an unknown analytic key.
-    """
-    from matplotlib.ticker import FuncFormatter, LogLocator
-
-    mus = _vector("mus", mus, per="mu")
-    if len(mus) == 0 or not np.all(mus > 0):
-        raise ValueError("mus: needs at least one friction coefficient, each > 0")
-    arcs = {"driver": _vector("slip_arcs_driver", slip_arcs_driver, len(mus), "mu"),
-            "driven": _vector("slip_arcs_driven", slip_arcs_driven, len(mus), "mu")}
-    exact = _analytic_parts("analytic", analytic, tuple(arcs))
-    wraps = None if wraps is None else _vector("wraps", wraps, 2, "pulley")
-    grid = np.geomspace(mus.min(), mus.max(), CURVE_SAMPLES)
-    fig, (ax,), own = panel_axes(ax, 1, figsize=(7.5, 4.8))
-    styles = {"driver": ("tab:blue", "o", 7), "driven": ("tab:orange", "s", 4)}
-    for k, (name, values) in enumerate(arcs.items()):
-        color, marker, size = styles[name]
-        if name in exact:
-            xs, ys = _curve(f"analytic[{name!r}]", exact[name], mus, grid)
-            ax.plot(xs, ys, color=color, lw=1.3, ls="-" if k == 0 else "--",
-                    label=f"{name} pulley: analytic")
-        ax.plot(mus, values, marker, color=color, ms=size, mfc="none" if k == 0 else color,
-                mew=1.4, label=f"{name} pulley")
-        if wraps is not None:
-            ax.axhline(wraps[k], color=color, ls=":", lw=1.2,
-                       label=f"{name} wrap {wraps[k]:.3g} rad (gross slip)")
-    ax.set_xscale("log")
-    # plain numbers (0.2, 0.5, 1, 2, ...) read better than powers of ten over a decade or two
-    ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
-    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    ax.set_ylim(bottom=0.0)
-    ax.set_xlabel("friction coefficient μ")
-    ax.set_ylabel("slip arc [rad]")
-    ax.secondary_yaxis("right", functions=(np.degrees, np.radians)).set_ylabel(
-        "slip arc [°]")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8, loc="best")
-    if own:
-        ax.set_title("slip arcs collapse onto the arcs' exits as μ grows", fontsize=10)
-    return fig
-
-
-__all__ = ["animate_drive", "draw_drive", "plot_characteristic", "plot_drive_history",
-           "plot_loop_fields", "plot_slip_collapse"]
+__all__ = ["animate_drive", "draw_drive", "plot_drive_history", "plot_loop_fields"]

@@ -279,8 +279,12 @@ def _discrete_reference(scene):
     key = _steady_key(scene)
     if key not in _STEADY:
         sim = Simulation(scene.with_overrides([("numerics.integrator", "steady")]))
-        res = sim.run(raise_on_failure=False)
-        _STEADY[key] = sim.readout.discrete_reference(res.solution) if res.converged else None
+        try:
+            res = sim.run(raise_on_failure=False)
+        except NoSolutionError:  # a drive beyond its capacity: the exact state serves
+            res = None
+        _STEADY[key] = (sim.readout.discrete_reference(res.solution)
+                        if res is not None and res.converged else None)
     return _STEADY[key]
 
 
