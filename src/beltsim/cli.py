@@ -334,7 +334,7 @@ def _stored_drive(run_dir) -> bool:
     """Whether a run directory holds a closed drive's run (its scene.toml has [drive])."""
     import tomllib
 
-    from .api import is_drive_data
+    from .problem.kinds import is_drive_data
 
     try:
         return is_drive_data(tomllib.loads((run_dir / "scene.toml").read_text(encoding="utf-8")))

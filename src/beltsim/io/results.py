@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SceneError
+from ..problem.kinds import scene_from_tables
 from ..problem.scene import Scene
 from .files import OutputError, prepare_outdir, write_atomic, write_csv, write_json
 
@@ -101,8 +102,6 @@ def write_checkpoint(path, sim) -> Path:
 def read_checkpoint(path) -> dict:
     """The parts of :func:`write_checkpoint`: scene (of either kind), t, wall_time, state,
     scheme, trackers."""
-    from ..api import scene_from_tables
-
     try:
         with np.load(path) as z:
             scene = scene_from_tables(tomllib.loads(str(z["scene"])))
