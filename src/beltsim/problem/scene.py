@@ -97,7 +97,8 @@ class Scene(SceneTables):
     set_key = staticmethod(set_key)
 
     def section_table(self, name: str, value):
-        """A section for :meth:`replace`: its typed class or its table (:func:`_table`)."""
+        """A section for :meth:`replace`: its typed class (:mod:`beltsim.problem.builder`) or
+        its table."""
         return _table(name, value)
 
     @classmethod

@@ -26,7 +26,8 @@ class Readout:
 
     #: what snapshots store of the state (arrays over the nodes)
     snapshot_keys = ("u", "theta", "fnode")
-    #: the errors a study reports, of :meth:`RunResult.errors` (relative; slip start in m)
+    #: the errors a study reports, of :meth:`~beltsim.simulation.result.RunResult.errors`
+    #: (relative; slip start in m)
     error_keys = ("total_friction", "u", "theta", "concentrated_force", "slip_start")
 
     def __init__(self, disc):
@@ -155,7 +156,7 @@ class LoopReadout(Readout):
     @staticmethod
     def discrete_reference(solution):
         """A drive's discrete steady state: its own summary is what another's errors
-        compare with (:meth:`LoopSolution.errors`)."""
+        compare with (:meth:`~beltsim.simulation.loop_solution.LoopSolution.errors`)."""
         return solution
 
 
