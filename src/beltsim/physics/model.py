@@ -61,6 +61,11 @@ GYROSCOPIC_FORMS = {"upwind": UPWIND, "central": CENTRAL}
 # then f* (1 - 1e-14), and g^{-1} stays finite
 LAM_MAX = 1.0 - 1e-14
 
+#: :func:`assemble`'s ``want_jac``, with or without the Jacobian. numba compiles a kernel
+#: once for each literal True or False it is called with; these numpy booleans are typed
+#: as plain ``bool``, so every caller shares one compiled assemble.
+JACOBIAN, RESIDUAL = np.bool_(True), np.bool_(False)
+
 
 class ModelParams(NamedTuple):
     """The coefficients of the discrete model, as the kernels read them."""

@@ -261,7 +261,8 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
             for k in range(power.shape[0]):
                 work[k] += 0.5 * h * (power[k] + p_new[k])
                 power[k] = p_new[k]
-            h_next = h * step_factor(err, tol, True, MAX_GROWTH)
+            # ok (true here), not the literal True: one compile of step_factor for both calls
+            h_next = h * step_factor(err, tol, ok, MAX_GROWTH)
             continue
         # rejected: back to t_n with a smaller step
         rejected += 1
