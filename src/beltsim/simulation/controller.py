@@ -21,6 +21,7 @@ from ..errors import NumericalError
 from ..physics.grid import Grid
 from ..problem.drive import period_of, profile_times
 from ..problem.scene import Scene
+from .progress import ProgressTracker
 from .readout import readout_of
 from .result import RunResult, RunStatus
 from .trackers import (
@@ -31,7 +32,6 @@ from .trackers import (
     OutcomeTracker,
     PeriodicTracker,
     PowerBalanceTracker,
-    ProgressTracker,
     SignalTracker,
     SnapshotTracker,
     SteadyStateTracker,
