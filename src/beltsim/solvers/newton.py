@@ -293,7 +293,7 @@ def update_converged(update, previous, it, tol):
             or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # one compile inside each scheme, not two
 def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     """Solve the step's residual for (u, theta, lam) of ``state`` in place, from their values.
 
