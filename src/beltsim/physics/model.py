@@ -287,7 +287,7 @@ def wrap(k, n):
     return k + n if k < 0 else (k - n if k >= n else k)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def bottom_strain(u, th, hh, sw, j):
     """d/dx u_b at friction node j from the stencil weights sw[j] (periodic on a loop)."""
     e = 0.0
@@ -543,7 +543,7 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
         R[i, 1] = rt
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def loop_friction(w, bd, i, j, s, m, k, dSe, dSc, S, inv_dt, c, hh, mesh, p, want_jac):
     """A loop's friction terms at node j (row i) beyond the open layout's: the slopes of
     its force wf S m (m the ratio, condensed for a regularised law) through the pressure
@@ -637,7 +637,7 @@ def add_stick_penalty(w, inv_dt, fs, c, mesh, p):
 
 
 # a call, not inline="always": inlined, this choice made assemble three times slower
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def stencil_band(o, L2, Lb, Db):
     """The Jacobian block band of row j's column j - 2 + o."""
     if o == 0:
@@ -647,7 +647,7 @@ def stencil_band(o, L2, Lb, Db):
     return Db
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def add_friction_slope(w, i, j, k, inv_dt, c, hh, sw):
     """Add to row block i the Jacobian of a nodal force -k v_rel,j (k = -dF_j/dv_rel)."""
     for o in range(3):

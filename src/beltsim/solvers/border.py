@@ -44,7 +44,7 @@ class Border(NamedTuple):
                    np.zeros((nb, ni, b)), np.zeros((nb, nb)), np.zeros(nb))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
     """Fill bd's Bm, Cm, Dm from a loop's wrapped band (rows 0..n-1, each coupling to
     nodes i-2, i-1, i, i+1 modulo n) and its global blocks Gc (n, b, ng), Gr (ng, n, b),
@@ -87,7 +87,7 @@ def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
             bd.Dm[2 * b + k, 2 * b + m] = Gd[k, m]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def schur(bd):
     """bd.Sinv from bd.X = A^{-1} Bm; False when the complement is singular."""
     nb = bd.Dm.shape[0]
@@ -116,7 +116,7 @@ def schur(bd):
     return np.all(np.isfinite(bd.Sinv))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def finish(bd, r, rg, x, dg):
     """Complete a bordered solve: x[:n-2] holds A^{-1} r[:n-2] on entry; on return x
     (n, b) and dg (ng) solve the whole system with right-hand sides r (n, b), rg (ng).

@@ -112,7 +112,7 @@ class Workspace(NamedTuple):
                    border=Border.allocate(n, 2, ng) if closed else None)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def merit(R, Rg, scales):
     """The squared residual norm, each row's force and moment over their scales, each
     global row over its own."""
@@ -220,7 +220,7 @@ def factorise(w, mesh):
     return factorise_bordered(w, w.border)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def factorise_bordered(w, bd):
     """A loop's part of :func:`factorise`: the band without the border, then the border.
 
@@ -250,7 +250,7 @@ def linear_solve(w, mesh, r, rg, x, dg):
     finish(w.border, r, rg, x, dg)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def friction_forces(lam, fnode, u, g, t, mesh, p, drive):
     """The nodal friction forces of the friction ratios lam, as
     :func:`~beltsim.physics.model.assemble` sets them."""
@@ -261,7 +261,7 @@ def friction_forces(lam, fnode, u, g, t, mesh, p, drive):
         fnode[j] = -mesh.wf[j] * S * lam[j]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def release_stuck_ratios(lam, w, mesh, code):
     """Restart the friction ratios stuck at +-1 against their slip velocity; any?
 
@@ -395,7 +395,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def update_size(dx, dg, scales):
     """The scaled max norm of a Newton update of the rows (dx) and the globals (dg)."""
     step = 0.0
@@ -413,7 +413,7 @@ def update_size(dx, dg, scales):
     return step
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def newton_exact(s, state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     """Semi-smooth Newton on (u, theta, lam) and the globals for the exact laws (:mod:`.ssn`),
     on their system ``s`` (w.saddle).

@@ -244,7 +244,7 @@ def saddle_solve(s, mesh):
     return saddle_solve_bordered(s, s.border)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def saddle_solve_bordered(s, bd):
     """A loop's part of :func:`saddle_solve`: the band without the border, then the border.
 
@@ -266,7 +266,7 @@ def saddle_solve_bordered(s, bd):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def project(lam, mesh, code):
     """Ratios of sliding nodes back onto [-1, 1] (Coulomb): the update may overshoot."""
     if code != EXACT:
