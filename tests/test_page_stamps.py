@@ -39,6 +39,13 @@ def test_every_declared_source_exists():
             assert (stamps.ROOT / src).exists(), (key, src)
 
 
+def test_every_generated_page_declares_its_sources():
+    import validation.pages as vpages
+
+    pages = {f"verification/{name}.md" for name, _, _ in vpages._pages()}
+    assert pages | {"performance/timings.md"} == set(stamps.SOURCES)
+
+
 def test_a_page_carries_its_stamp(tmp_path):
     page = Page("p", "A page", "python -m x", "abc1234", tmp_path, source_hash="0123456789abcdef")
     text = page.markdown()
