@@ -25,6 +25,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from validation.pages import stamps
 from validation.pages.kit import (
     ROOT,
     Page,
@@ -344,7 +345,8 @@ def main(argv=None) -> int:
 
     command = command_line("benchmarks.pages", argv)
     sha = commit()
-    page = Page("timings", TITLE, command, sha, args.out, describe_machine(machine_facts()))
+    page = Page("timings", TITLE, command, sha, args.out, describe_machine(machine_facts()),
+                source_hash=stamps.page_hash("performance/timings.md"))
     start = time.perf_counter()
     status = 0
     try:

@@ -34,7 +34,9 @@ INDEX_TITLE = "Verification"
 INDEX_INTRO = (
     "How beltsim is checked against exact solutions, with the numbers of the last run. "
     "Each page below is written whole by `python -m validation.pages` from fresh runs "
-    "through beltsim's own API, and names the command and the commit that produced it; "
+    "through beltsim's own API, and names the command, the commit and the hash of the "
+    "sources that produced it (`python -m validation.pages.stamps` checks that no page is "
+    "older than its code); "
     "`python -m validation.pages --quick` runs the same studies on small grids (CI runs "
     "it). A failed run is shown as failed on its page, and the command exits non-zero.")
 
@@ -59,7 +61,10 @@ def run_page(name: str, title: str, build, quick: bool, out: Path, command: str,
     in place of a page, never a page that looks complete)."""
     from beltsim.errors import MissingInputError
 
-    page = Page(name, title, command, sha, out, machine)
+    from . import stamps
+
+    page = Page(name, title, command, sha, out, machine,
+                source_hash=stamps.page_hash(f"verification/{name}.md"))
     try:
         build(page, quick)
     except MissingInputError as exc:

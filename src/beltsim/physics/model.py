@@ -61,6 +61,11 @@ GYROSCOPIC_FORMS = {"upwind": UPWIND, "central": CENTRAL}
 # then f* (1 - 1e-14), and g^{-1} stays finite
 LAM_MAX = 1.0 - 1e-14
 
+#: :func:`assemble`'s ``want_jac``, with or without the Jacobian. numba compiles a kernel
+#: once for each literal True or False it is called with; these numpy booleans are typed
+#: as plain ``bool``, so every caller shares one compiled assemble.
+JACOBIAN, RESIDUAL = np.bool_(True), np.bool_(False)
+
 
 class ModelParams(NamedTuple):
     """The coefficients of the discrete model, as the kernels read them."""
@@ -282,7 +287,7 @@ def wrap(k, n):
     return k + n if k < 0 else (k - n if k >= n else k)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def bottom_strain(u, th, hh, sw, j):
     """d/dx u_b at friction node j from the stencil weights sw[j] (periodic on a loop)."""
     e = 0.0
@@ -511,7 +516,7 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
                 ru += wf[j] * S * lam[j]
                 rt += hh * wf[j] * S * lam[j]
                 if closed:
-                    loop_friction(w, i, j, s, lam[j], 0.0, dSe, dSc, S, inv_dt, c, hh,
+                    loop_friction(w, w.border, i, j, s, lam[j], 0.0, dSe, dSc, S, inv_dt, c, hh,
                                   mesh, p, want_jac)
                 R[i, 0] = ru
                 R[i, 1] = rt
@@ -531,19 +536,25 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
                 add_friction_slope(w, i, j, friction_stiffness(wj, S, sg[j], p), inv_dt, c,
                                    hh, sw)
             if closed:
-                loop_friction(w, i, j, s, lam[j] + sg[j] * rl[j],
+                loop_friction(w, w.border, i, j, s, lam[j] + sg[j] * rl[j],
                               friction_stiffness(wj, S, sg[j], p), dSe, dSc, S, inv_dt, c, hh,
                               mesh, p, want_jac)
         R[i, 0] = ru
         R[i, 1] = rt
 
 
-@njit(cache=True)
-def loop_friction(w, i, j, s, m, k, dSe, dSc, S, inv_dt, c, hh, mesh, p, want_jac):
+@njit(cache=True, no_cpython_wrapper=True)
+def loop_friction(w, bd, i, j, s, m, k, dSe, dSc, S, inv_dt, c, hh, mesh, p, want_jac):
     """A loop's friction terms at node j (row i) beyond the open layout's: the slopes of
     its force wf S m (m the ratio, condensed for a regularised law) through the pressure
     bound S(u_x, c) and through v_rel in the globals (k = -dF/dv_rel), and the force's
-    moment on its free pulley's row with all its slopes."""
+    moment on its free pulley's row with all its slopes.
+
+    ``bd`` is w.border: None on an open layout's workspace, which never comes here; its
+    type prunes the body, so an open layout does not compile it.
+    """
+    if bd is None:
+        return
     wj = mesh.wf[j]
     K = mesh.seg_speed[s]
     Rs = mesh.seg_radius[s]
@@ -621,12 +632,12 @@ def add_stick_penalty(w, inv_dt, fs, c, mesh, p):
         k = friction_stiffness(mesh.wf[j], S, w.sg[j], p)
         add_friction_slope(w, j - mesh.off, j, k, inv_dt, c, p.half_height, mesh.sw)
         if mesh.off == 0:
-            loop_friction(w, j, j, mesh.seg[j], 0.0, k, 0.0, 0.0, S, inv_dt, c,
-                          p.half_height, mesh, p, True)
+            loop_friction(w, w.border, j, j, mesh.seg[j], 0.0, k, 0.0, 0.0, S, inv_dt, c,
+                          p.half_height, mesh, p, JACOBIAN)
 
 
 # a call, not inline="always": inlined, this choice made assemble three times slower
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def stencil_band(o, L2, Lb, Db):
     """The Jacobian block band of row j's column j - 2 + o."""
     if o == 0:
@@ -636,7 +647,7 @@ def stencil_band(o, L2, Lb, Db):
     return Db
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def add_friction_slope(w, i, j, k, inv_dt, c, hh, sw):
     """Add to row block i the Jacobian of a nodal force -k v_rel,j (k = -dF_j/dv_rel)."""
     for o in range(3):

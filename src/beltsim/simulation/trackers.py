@@ -233,6 +233,16 @@ class SteadyStateTracker(Tracker):
             return Stop(RunStatus.CONVERGED)
         return None
 
+    @property
+    def span(self) -> float:
+        """The window (s) over which the change is measured."""
+        return self.window
+
+    def measure(self) -> float:
+        """What must stay below ``tol``: the larger of the rate and the change at the
+        last check (the rate alone in the first window, where no change is defined)."""
+        return self.rate if math.isinf(self.change) else max(self.rate, self.change)
+
     def not_steady(self, t_end: float) -> str:
         """The reason of a run that reached t_end before steady state."""
         return (f"not steady by t_end = {t_end:.6g} s (rate {self.rate:.3g}, friction change "
@@ -298,6 +308,15 @@ class PeriodicTracker(Tracker):
             out[key] = {"min": float(rows[:, col].min()), "max": float(rows[:, col].max()),
                         "mean": float(rows[:, col].mean())}  # equal phases: exact for a sine
         return out
+
+    @property
+    def span(self) -> float:
+        """The period (s): the change is measured between two."""
+        return self.period
+
+    def measure(self) -> float:
+        """What must stay below ``tol``: the change between the last two periods."""
+        return self.change
 
     def not_steady(self, t_end: float) -> str:
         """The reason of a run that reached t_end before its periodic steady state."""
@@ -440,35 +459,6 @@ def _has_widgets() -> bool:
     from importlib.util import find_spec
 
     return find_spec("ipywidgets") is not None
-
-
-class ProgressTracker(Tracker):
-    """A progress bar of simulated time, with the rate and the total friction.
-
-    A widget in Jupyter with ipywidgets (the ``notebook`` extra), else text
-    (:func:`progress_bar`): on a terminal, in a notebook without ipywidgets, or in
-    whatever takes stderr (the CLI asks for it only on a terminal).
-    """
-
-    def __init__(self):
-        self.bar = None
-
-    def initialize(self, sim):
-        self.bar = progress_bar(total=sim.numerics.t_end, initial=sim.t, unit="s",
-                                unit_scale=True, desc="simulated", leave=False,
-                                bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s "
-                                           "[{elapsed}<{remaining}]{postfix}")
-
-    def handle(self, sim):
-        if self.bar is not None:
-            self.bar.update(min(sim.t, sim.numerics.t_end) - self.bar.n)
-            self.bar.set_postfix(rate=f"{sim.rate():.2e}", monitor=f"{sim.monitor():.5g}",
-                                 refresh=False)
-        return None
-
-    def finalize(self, sim, status):
-        if self.bar is not None:
-            self.bar.close()
 
 
 class CallbackTracker(Tracker):

@@ -40,6 +40,7 @@ from numba import njit
 from ..physics.friction import EXACT, LINEAR, RAMP, law
 from ..physics.model import (
     LAM_MAX,
+    RESIDUAL,
     assemble,
     bottom_strain,
     contact_target,
@@ -91,7 +92,6 @@ class Rates(NamedTuple):
         return cls(*(np.zeros(n_nodes) for _ in cls._fields))
 
 
-@njit(cache=True)
 def initial_acceleration(state, base, t, mesh, p, drive, loads, w, au, at):
     """The accelerations of ``state`` at t from the model, into au, at (the first step's
     first stage).
@@ -99,14 +99,40 @@ def initial_acceleration(state, base, t, mesh, p, drive, loads, w, au, at):
     The residual of :func:`~beltsim.physics.model.assemble` with ``inv_dt`` = 1 and the
     old state (u - u_t, theta - theta_t) at the same rates is the equation of motion
     at zero acceleration, so a = -R / (m hbar) (zero where the mass m is). The
-    friction ratios are first set from the state's slip velocities (a regularised law),
-    or projected as the exact Coulomb law's iteration does (a sliding node then carries
-    +-1; a sticking node's ratio and adhesion's are reactions and keep their values).
-    A loop's globals keep their rates (state.gd): the old globals are g - g_t.
+    friction ratios are first set from the state's slip velocities
+    (:func:`initial_ratios`). A loop's globals keep their rates (state.gd): the old
+    globals are g - g_t.
+
+    Called once a run, it is Python around two kernels, the ratios and the same compiled
+    assemble that Newton calls: a kernel of its own would compile assemble's code once
+    more. Its own arithmetic is elementwise, the kernel's to the bit.
     """
+    u, th, ud, td, g = state.u, state.theta, state.ud, state.td, state.g
+    initial_ratios(state, t, mesh, p, drive)
+    base.u[:] = u - ud
+    base.theta[:] = th - td
+    base.ud[:] = ud
+    base.td[:] = td
+    base.g[:] = g - state.gd
+    assemble(u, th, state.lam, g, state.fnode, base, 1.0, t, mesh, p, drive, loads, w,
+             RESIDUAL)
+    n, off = w.R.shape[0], mesh.off
+    hb = mesh.hb[off:off + n]
+    au[:] = 0.0
+    at[:] = 0.0
+    if p.mass > 0.0:
+        au[off:off + n] = -w.R[:, 0] / (p.mass * hb)
+    if p.rotary_inertia > 0.0:
+        at[off:off + n] = -w.R[:, 1] / (p.rotary_inertia * hb)
+
+
+@njit(cache=True)
+def initial_ratios(state, t, mesh, p, drive):
+    """The friction ratios of ``state`` at t from its slip velocities: by a regularised
+    law, or projected as the exact Coulomb law's iteration does (a sliding node then
+    carries +-1; a sticking node's ratio and adhesion's are reactions and keep their
+    values)."""
     u, th, lam, ud, td, g = state.u, state.theta, state.lam, state.ud, state.td, state.g
-    nodes = u.shape[0]
-    off = mesh.off
     hh, code = p.half_height, p.law
     c = loop_speed(g, mesh, p)
     target = mismatch(drive, t)
@@ -120,19 +146,6 @@ def initial_acceleration(state, base, t, mesh, p, drive, loads, w, au, at):
         elif code < EXACT:
             gr = law(code, s)[0]
             lam[j] = gr if code == LINEAR or code == RAMP else min(LAM_MAX, max(-LAM_MAX, gr))
-    for j in range(nodes):
-        base.u[j], base.theta[j] = u[j] - ud[j], th[j] - td[j]
-        base.ud[j], base.td[j] = ud[j], td[j]
-    for k in range(g.shape[0]):
-        base.g[k] = g[k] - state.gd[k]
-    assemble(u, th, lam, g, state.fnode, base, 1.0, t, mesh, p, drive, loads, w, False)
-    for j in range(nodes):
-        au[j] = at[j] = 0.0
-    for i in range(w.R.shape[0]):
-        j = i + off
-        au[j] = -w.R[i, 0] / (p.mass * mesh.hb[j]) if p.mass > 0.0 else 0.0
-        at[j] = (-w.R[i, 1] / (p.rotary_inertia * mesh.hb[j])
-                 if p.rotary_inertia > 0.0 else 0.0)
 
 
 @njit(cache=True)
@@ -297,7 +310,8 @@ def advance_esdirk(state, rates, base, t, t_stop, h_prev, h_next, h_min, h_max, 
             for k in range(power.shape[0]):
                 work[k] += h * (B1 * ps[0, k] + B2 * ps[1, k] + B3 * ps[2, k] + B4 * ps[3, k])
                 power[k] = ps[3, k]
-            h_next = h * step_factor(err, tol, True, MAX_GROWTH)
+            # ok (true here), not the literal True: one compile of step_factor for both calls
+            h_next = h * step_factor(err, tol, ok, MAX_GROWTH)
             continue
         # rejected: back to t_n with a smaller step
         rejected += 1
@@ -321,6 +335,15 @@ class EsdirkScheme(AdaptiveScheme):
         super().__init__(disc)
         self.rates = Rates.zeros(len(disc.mesh.hb))
         self.started = False  # whether rates.au, rates.at hold the state's accelerations
+
+    def _compile(self, state) -> None:
+        super()._compile(state)
+        # the first step's kernels too, on copies, so that the warm-up holds all the
+        # compiling and the run's wall time none (assemble is compiled by then)
+        d = self.disc
+        initial_ratios(state.copy(), 0.0, d.mesh, d.model, d.drive)
+        power_terms(state.copy(), 0.0, d.mesh, d.model, d.drive, d.loads,
+                    np.zeros_like(self.power))
 
     def advance(self, state, t, t_stop, max_steps=10**9):
         d, num = self.disc, self.numerics

@@ -50,7 +50,7 @@ BDF2_ERROR = 2.0 / 9.0  # leading error constant of BDF2 at a constant step
 NEWTON_CUT = 0.25  # step factor after a failed Newton solve
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def step_factor(err, tol, ok, max_growth):
     """The next step over this one under local error control (error ~ h^3): after a
     converged step with error estimate err, SAFETY (tol / err)^(1/3) within [MIN_SHRINK,
@@ -62,7 +62,7 @@ def step_factor(err, tol, ok, max_growth):
     return min(max_growth, max(MIN_SHRINK, SAFETY * (tol / err) ** (1.0 / 3.0)))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def copy_state(u, th, ud, td, lam, u_n, th_n, ud_n, td_n, lam_n):
     """(u, th, ud, td, lam) = (u_n, ...): the state saved at t_n, or a rejected step's
     state back to t_n."""
@@ -70,14 +70,14 @@ def copy_state(u, th, ud, td, lam, u_n, th_n, ud_n, td_n, lam_n):
         u[j], th[j], ud[j], td[j], lam[j] = u_n[j], th_n[j], ud_n[j], td_n[j], lam_n[j]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def copy_globals(g, gd, g_n, gd_n):
     """(g, gd) = (g_n, gd_n): a loop's global unknowns and their rates."""
     for k in range(g.shape[0]):
         g[k], gd[k] = g_n[k], gd_n[k]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def landing_step(remaining, h_next, h_max):
     """The step that ends on the stop time: the remaining span in equal parts of at most
     min(h_next, h_max)."""
@@ -105,7 +105,7 @@ class History(NamedTuple):
                    np.zeros(n_globals))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def filtered_error(e, eg, a0, fs, c, mesh, p, w, out, outg):
     """Solve J e_f = T e in place of ``e`` (n, 2) and a loop's ``eg`` (ng); J: the step's
     Newton matrix, T: its a0 part.
@@ -119,7 +119,7 @@ def filtered_error(e, eg, a0, fs, c, mesh, p, w, out, outg):
     linear_solve(w, mesh, out, outg, e, eg)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def predict_friction(lam, lam_prev, r, mesh, code):
     """Extrapolate the friction ratios lam (at t_n, in place) linearly to t_n + r (t_n - t_{n-1}).
 
@@ -262,7 +262,8 @@ def advance_bdf2(state, hist, base, t, t_stop, h_prev, h_next, h_min, h_max, tol
             for k in range(power.shape[0]):
                 work[k] += 0.5 * h * (power[k] + p_new[k])
                 power[k] = p_new[k]
-            h_next = h * step_factor(err, tol, True, MAX_GROWTH)
+            # ok (true here), not the literal True: one compile of step_factor for both calls
+            h_next = h * step_factor(err, tol, ok, MAX_GROWTH)
             continue
         # rejected: back to t_n with a smaller step
         rejected += 1

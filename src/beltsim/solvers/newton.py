@@ -19,6 +19,7 @@ from numba import njit
 from ..errors import FailureKind, NumericalError
 from ..physics.friction import EXACT, is_exact, law, law_inverse
 from ..physics.model import (
+    JACOBIAN,
     add_stick_penalty,
     assemble,
     bound_scale,
@@ -84,7 +85,7 @@ class Workspace(NamedTuple):
     sgf: np.ndarray  # those of the factorised Jacobian
     lam0: np.ndarray  # friction ratios before the last update (nodes)
     stats: np.ndarray  # one record of STATS_DTYPE
-    saddle: Saddle  # the exact laws' 3x3 system (empty for the regularised ones)
+    saddle: Saddle | None  # the exact laws' 3x3 system (None for the regularised ones)
     bs: np.ndarray  # friction bound S_j of each friction node at the last assembly
     vc: np.ndarray  # a loop's d v_rel / dc at each friction node
     Rg: np.ndarray  # a loop's global rows: residual (ng), slopes (physics.model.assemble)
@@ -93,7 +94,7 @@ class Workspace(NamedTuple):
     Gd: np.ndarray  # (ng, ng)
     dg: np.ndarray  # the globals' Newton update
     g_try: np.ndarray  # their line-search trial
-    border: Border  # a loop's bordered solve (empty when open)
+    border: Border | None  # a loop's bordered solve (None when open)
 
     @classmethod
     def allocate(cls, n_elements: int, exact: bool = False, closed: bool = False,
@@ -110,13 +111,13 @@ class Workspace(NamedTuple):
                    rl=z(nodes), sg=z(nodes), sgf=z(nodes), lam0=z(nodes),
                    stats=np.zeros(1, STATS_DTYPE),
                    saddle=Saddle.allocate(n, ng if closed else 0, closed) if exact
-                   else Saddle.empty(),
+                   else None,
                    bs=z(nodes), vc=z(nodes), Rg=z(ng), Gc=z((n, 2, ng)), Gr=z((ng, n, 2)),
                    Gd=z((ng, ng)), dg=z(ng), g_try=z(ng),
-                   border=Border.allocate(n, 2, ng) if closed else Border.empty())
+                   border=Border.allocate(n, 2, ng) if closed else None)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def merit(R, Rg, scales):
     """The squared residual norm, each row's force and moment over their scales, each
     global row over its own."""
@@ -221,10 +222,21 @@ def factorise(w, mesh):
         w.sgf[j] = w.sg[j]
     if mesh.off == 1:
         return block_factor(w.Lb, w.Db, w.Ub, w)
+    return factorise_bordered(w, w.border)
+
+
+@njit(cache=True, no_cpython_wrapper=True)
+def factorise_bordered(w, bd):
+    """A loop's part of :func:`factorise`: the band without the border, then the border.
+
+    An open layout's workspace has no border (``bd`` None) and never comes here; its
+    type prunes the body, so an open layout compiles none of the border's kernels.
+    """
+    if bd is None:
+        return False
     ni = w.Db.shape[0] - 2
     if not block_factor(w.Lb[:ni], w.Db[:ni], w.Ub[:ni], w):
         return False
-    bd = w.border
     gather(w.Lb, w.L2, w.Db, w.Ub, w.Gc, w.Gr, w.Gd, bd)
     for q in range(bd.Bm.shape[0]):
         block_substitute(w, bd.Bm[q], bd.X[q])
@@ -243,7 +255,7 @@ def linear_solve(w, mesh, r, rg, x, dg):
     finish(w.border, r, rg, x, dg)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def friction_forces(lam, fnode, u, g, t, mesh, p, drive):
     """The nodal friction forces of the friction ratios lam, as
     :func:`~beltsim.physics.model.assemble` sets them."""
@@ -254,7 +266,7 @@ def friction_forces(lam, fnode, u, g, t, mesh, p, drive):
         fnode[j] = -mesh.wf[j] * S * lam[j]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def release_stuck_ratios(lam, w, mesh, code):
     """Restart the friction ratios stuck at +-1 against their slip velocity; any?
 
@@ -286,7 +298,7 @@ def update_converged(update, previous, it, tol):
             or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # one compile inside each scheme, not two
 def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     """Solve the step's residual for (u, theta, lam) of ``state`` in place, from their values.
 
@@ -303,7 +315,8 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     estimate. Returns True on convergence.
     """
     if p.law >= EXACT:
-        return newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w)
+        return newton_exact(w.saddle, state, old, inv_dt, t, mesh, p, drive, loads, scales,
+                            settings, w)
     u, th, lam, fnode, g = state.u, state.theta, state.lam, state.fnode, state.g
     R, dx, u_try, th_try = w.R, w.dx, w.u_try, w.th_try
     Rg, dg, g_try = w.Rg, w.dg, w.g_try
@@ -312,7 +325,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     st = w.stats[0]
     tol = settings.tol
     n = R.shape[0]
-    assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+    assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)
     m0 = merit(R, Rg, scales)
     if m0 == 0.0:
         return factorise(w, mesh)  # the factors are the step's (its error estimate's)
@@ -349,7 +362,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
                     and not release_stuck_ratios(lam, w, mesh, p.law)):
                 friction_forces(lam, fnode, u, g, t, mesh, p, drive)
                 return True
-            assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+            assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)
             previous = update
             continue
         alpha = 1.0
@@ -362,7 +375,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
             for k in range(ng):
                 g_try[k] = g[k] + alpha * dg[k]
             assemble(u_try, th_try, lam, g_try, fnode, old, inv_dt, t, mesh, p, drive, loads,
-                     w, True)
+                     w, JACOBIAN)
             m = merit(R, Rg, scales)
             if m <= (1.0 - 1e-4 * alpha) * m0:
                 accepted = True
@@ -371,7 +384,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
             st.line_search_cuts += 1
         if not accepted:
             # no decrease possible: fine if already at round-off, else a failure
-            assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+            assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)
             st.merit = m0
             return step < ROUNDOFF_FLOOR * tol
         for i in range(n):
@@ -387,7 +400,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def update_size(dx, dg, scales):
     """The scaled max norm of a Newton update of the rows (dx) and the globals (dg)."""
     step = 0.0
@@ -405,9 +418,10 @@ def update_size(dx, dg, scales):
     return step
 
 
-@njit(cache=True)
-def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
-    """Semi-smooth Newton on (u, theta, lam) and the globals for the exact laws (:mod:`.ssn`).
+@njit(cache=True, no_cpython_wrapper=True)
+def newton_exact(s, state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
+    """Semi-smooth Newton on (u, theta, lam) and the globals for the exact laws (:mod:`.ssn`),
+    on their system ``s`` (w.saddle).
 
     Full steps; converged when the update passes :func:`newton`'s tests and the
     stick/slip state of every friction node is the one the last step was solved with.
@@ -418,9 +432,14 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
     On return, w holds the block LU of the 2x2 Jacobian with the stuck nodes' slope
     f_s AUGMENTATION / v_aug, the default regularisation's (a penalty standing in for
     their constraint), for the step's error estimate, as :func:`newton` leaves its own.
+
+    A regularised law's workspace has no such system (``s`` None) and never comes here;
+    its type prunes the body, so a regularised scene compiles none of the exact laws'
+    kernels.
     """
+    if s is None:
+        return False
     u, th, lam, fnode, g = state.u, state.theta, state.lam, state.fnode, state.g
-    s = w.saddle
     st = w.stats[0]
     tol = settings.tol
     n = w.R.shape[0]
@@ -428,7 +447,7 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
     fs = p.friction_scale * friction_factor(drive, t)
     for j in range(s.active.shape[0]):
         s.active[j] = -1.0
-    assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+    assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)
     saddle_system(lam, loop_speed(g, mesh, p), inv_dt, fs, mesh, p, w, s)
     previous = np.inf
     for it in range(settings.max_iterations):
@@ -447,7 +466,7 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
         m_before = saddle_merit(s, scales) if damped else 0.0
         alpha = 1.0
         shift_saddle(state, s, mesh, alpha)
-        assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+        assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)
         changed = saddle_system(lam, loop_speed(g, mesh, p), inv_dt, fs, mesh, p, w, s)
         # past CYCLE_ITERATIONS a pattern that still changes is cycling: the step is
         # halved until the whole residual (the friction rows' too) decreases
@@ -457,7 +476,7 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
             alpha *= 0.5
             shift_saddle(state, s, mesh, -alpha)
             st.line_search_cuts += 1
-            assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, True)
+            assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)
             changed = saddle_system(lam, loop_speed(g, mesh, p), inv_dt, fs, mesh, p, w, s)
         update = alpha * max(step, dlam)
         # a front node may flip between stick and slip at round-off: a residual at its
@@ -474,7 +493,7 @@ def newton_exact(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings,
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def on_path(g, g_start, scales):
     """Whether a step kept a loop's globals within their scales (the rim speed, the
     pulley's speed) of the step's start: one that moved them further converged on another
@@ -486,7 +505,7 @@ def on_path(g, g_start, scales):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def shift_saddle(state, s, mesh, alpha):
     """(u, theta, the friction ratios, the globals) += alpha times the semi-smooth
     Newton update in s."""
@@ -500,7 +519,7 @@ def shift_saddle(state, s, mesh, alpha):
         state.lam[j] += alpha * s.dx[j - off, 2]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def saddle_merit(s, scales):
     """The squared norm of the semi-smooth system's residual: :func:`merit` of its force,
     moment and global rows, plus its friction rows (ratios, already dimensionless)."""
@@ -516,8 +535,10 @@ class NewtonScheme(Scheme):
     def __init__(self, disc):
         super().__init__(disc)
         num = self.numerics
-        self.work = Workspace.allocate(disc.grid.n_elements, is_exact(disc.model.law),
-                                       disc.mesh.off == 0, disc.n_globals)
+        #: Workspace.allocate's arguments (a scratch workspace of the same numba type)
+        self.workspace_shape = (disc.grid.n_elements, is_exact(disc.model.law),
+                                disc.mesh.off == 0, disc.n_globals)
+        self.work = Workspace.allocate(*self.workspace_shape)
         self.settings = NewtonSettings(num.newton_tol, num.newton_max_iterations)
         # the previous step's state (with inv_dt = 0, the steady equations ignore it)
         self.old = disc.new_state()

@@ -45,7 +45,7 @@ class Saddle(NamedTuple):
     Gd: np.ndarray
     Rg: np.ndarray  # the global rows' right-hand side (ng) and solution (ng)
     dg: np.ndarray
-    border: Border
+    border: Border | None  # None on an open layout
 
     @classmethod
     def allocate(cls, n_rows: int, n_globals: int = 0, closed: bool = False) -> Saddle:
@@ -55,12 +55,7 @@ class Saddle(NamedTuple):
         return cls(z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)),
                    z((n, 3, 3)), z((n, 3, 3)), z((n, 3)), z((n, 3)), z(n + 2 - 2 * closed),
                    z((n, 3, ng)), z((ng, n, 3)), z((ng, ng)), z(ng), z(ng),
-                   Border.allocate(n, 3, ng) if closed else Border.empty(3))
-
-    @classmethod
-    def empty(cls) -> Saddle:
-        """Zero-size arrays, for a law that needs none (a regularised one)."""
-        return cls.allocate(-1)
+                   Border.allocate(n, 3, ng) if closed else None)
 
 
 @njit(cache=True)
@@ -246,10 +241,21 @@ def saddle_solve(s, mesh):
             return False
         saddle_substitute(s, s.R, s.dx)
         return True
-    ni = n - 2
+    return saddle_solve_bordered(s, s.border)
+
+
+@njit(cache=True, no_cpython_wrapper=True)
+def saddle_solve_bordered(s, bd):
+    """A loop's part of :func:`saddle_solve`: the band without the border, then the border.
+
+    An open layout's system has no border (``bd`` None) and never comes here; its type
+    prunes the body, so an open layout compiles none of the border's kernels.
+    """
+    if bd is None:
+        return False
+    ni = s.Db.shape[0] - 2
     if not saddle_factor(s, ni):
         return False
-    bd = s.border
     gather(s.Lb, s.L2, s.Db, s.Ub, s.Gc, s.Gr, s.Gd, bd)
     for q in range(bd.Bm.shape[0]):
         saddle_substitute(s, bd.Bm[q], bd.X[q])
@@ -260,7 +266,7 @@ def saddle_solve(s, mesh):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True)
 def project(lam, mesh, code):
     """Ratios of sliding nodes back onto [-1, 1] (Coulomb): the update may overshoot."""
     if code != EXACT:
