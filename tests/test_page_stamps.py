@@ -51,3 +51,13 @@ def test_a_page_carries_its_stamp(tmp_path):
     text = page.markdown()
     assert stamps.STAMP.search(text).group(1) == "0123456789abcdef"
     assert "source hash `0123456789abcdef`" in text
+
+
+def test_a_stale_page_fails_the_check_and_is_only_named_in_report_mode(monkeypatch, capsys):
+    monkeypatch.setattr(stamps, "check", lambda key, restamp=False: "its sources changed")
+    assert stamps.main([]) == 1
+    assert stamps.main(["--report"]) == 0
+    out = capsys.readouterr().out
+    assert "docs/verification/drive.md is stale" in out and "0 of" in out
+    monkeypatch.setattr(stamps, "check", lambda key, restamp=False: None)
+    assert stamps.main([]) == 0
