@@ -318,7 +318,7 @@ def test_study_and_paper_figures_take_axes(pyplot_state):
 def test_progress_shows_without_a_terminal(capsys):
     """tqdm.auto writes its bar wherever stderr goes (a notebook's output, here a capture)."""
     beltsim.run(Scene.build(**PAPER_SLIP, numerics=COARSE), progress=True)
-    assert "simulated" in capsys.readouterr().err
+    assert "to steady" in capsys.readouterr().err
     beltsim.run(Scene.build(**PAPER_SLIP, numerics=COARSE))
     assert capsys.readouterr().err == ""
 
@@ -329,7 +329,7 @@ def test_the_cli_keeps_its_log_free_of_bars(tmp_path, capsys):
 
     assert main(["run", "paper_slip", "--set", "numerics.elements=60", "--out",
                  str(tmp_path)]) == 0
-    assert "simulated" not in capsys.readouterr().err
+    assert "to steady" not in capsys.readouterr().err
 
 
 class FrictionLog(Tracker):
