@@ -94,6 +94,7 @@ class ProgressTracker(Tracker):
         self.estimate = None
 
     def initialize(self, sim):
+        """Open the bar, its total the run's t_end until the steady test's measure decays."""
         num, steady = sim.numerics, sim.steady
         self.estimate = SteadyEstimate(steady.tol, steady.t_min, steady.hold, sim.check,
                                        steady.span, num.t_end)
@@ -103,6 +104,7 @@ class ProgressTracker(Tracker):
                                            "[{elapsed}<{remaining}]{postfix}")
 
     def handle(self, sim):
+        """Move the bar to the check's time, its total to the estimated steady time."""
         if self.bar is None:
             return None
         t = min(sim.t, sim.numerics.t_end)
@@ -116,6 +118,7 @@ class ProgressTracker(Tracker):
         return None
 
     def finalize(self, sim, status):
+        """Fill the bar where the run became steady, and close it."""
         if self.bar is None:
             return
         if status is RunStatus.CONVERGED:  # full: the estimate's end is now

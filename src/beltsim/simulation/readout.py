@@ -26,7 +26,7 @@ class Readout:
 
     #: what snapshots store of the state (arrays over the nodes)
     snapshot_keys = ("u", "theta", "fnode")
-    #: the errors a study reports, of :meth:`~beltsim.simulation.result.RunResult.errors`
+    #: the errors a study reports, of :meth:`beltsim.RunResult.errors`
     #: (relative; slip start in m)
     error_keys = ("total_friction", "u", "theta", "concentrated_force", "slip_start")
 
