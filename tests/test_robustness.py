@@ -184,10 +184,14 @@ def test_cli_numerical_failure_exits_3_with_summary_and_last_good_state(tmp_path
 
 @pytest.mark.cli
 @pytest.mark.verification
+@pytest.mark.long
 def test_stability_command_quick_matrix(tmp_path):
     """A coarse matrix (the issue's command): every cell reaches its grid's steady state
     (the steady scheme's, within DISCRETE_BOUNDS), is refused before running with a
-    reason, or does not apply; nothing diverges, hangs or writes NaN as a result."""
+    reason, or does not apply; nothing diverges, hangs or writes NaN as a result. The
+    README's suite runs the same coarse matrix through the stability page's quick mode
+    (tests/test_pages.py, which fails on a cell outside ACCEPTED); this test, marked
+    long, adds the command's own files and exit status."""
     proc = subprocess.run([sys.executable, "-m", "beltsim.cli", "stability", "--elements",
                            "60", "--out", str(tmp_path)], capture_output=True, text=True,
                           timeout=900)

@@ -29,7 +29,7 @@ QUICK_ELEMENTS = 60
 #: (scenes, seed, elements or None for each scene's default, max wall s) of the campaign,
 #: of straight belts and of closed drives, by --quick
 RANDOM = {False: (40, 1, None, 900.0), True: (3, 1, None, 120.0)}
-RANDOM_DRIVES = {False: (20, 1, None, 900.0), True: (2, 1, 200, 120.0)}
+RANDOM_DRIVES = {False: (20, 1, None, 900.0), True: (1, 1, 100, 60.0)}
 
 
 def _status(row) -> str:
