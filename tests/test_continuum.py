@@ -77,6 +77,7 @@ def test_the_central_discrete_spectrum_converges_to_the_exact_roots_at_second_or
 
 
 @pytest.mark.verification
+@pytest.mark.long  # 15 to 23 s a case
 @pytest.mark.parametrize("name, factor", [("paper_slip", 1), ("paper_slip", 8),
                                           ("paper_inertia", 1)])
 def test_the_default_form_settles_the_damped_paper_scenes(name, factor):
