@@ -44,8 +44,8 @@ from beltsim import solvers
 from beltsim.api import is_drive_scene
 from beltsim.errors import BeltsimError
 from beltsim.problem.scene import Scene
-from beltsim.simulation.readout import readout_class
 from beltsim.simulation.result import RunStatus
+from beltsim.studies.convergence import error_keys
 from beltsim.studies.stability import (
     ACCEPTED,
     BOUNDS,
@@ -132,8 +132,7 @@ def draw_scenes(n: int, seed: int, drives: bool = False) -> list:
 
 def _no_errors(scene) -> dict:
     """The error columns of the scene's layout, all nan (a cell that did not run)."""
-    return {f"error_{k}": math.nan
-            for k in readout_class(is_drive_scene(scene)).error_keys}
+    return {f"error_{k}": math.nan for k in error_keys(scene)}
 
 
 def scene_case(scene: Scene) -> Case:
