@@ -12,6 +12,7 @@ from helpers import cli, scene_path
 pytestmark = pytest.mark.cli
 
 
+@pytest.mark.long  # 11 s: an encode of each format (CI's budget; the other tests animate)
 def test_animate_runs_and_stores_an_mp4_then_a_gif_from_the_stored_run(tmp_path):
     run_dir = tmp_path / "run"
     proc = cli("animate", scene_path("paper_slip"), "--set", "numerics.elements=150",
