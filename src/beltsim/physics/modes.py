@@ -1,22 +1,25 @@
 """Linear stability of the discrete steady state: the eigenvalue with the largest real part.
 
-The semi-discrete model linearised about the steady state y0 (zero rates),
+The semi-discrete model of either layout linearised about the steady state y0 (zero
+rates),
 
     M z'' + C z' + K z = 0,   M = diag(rho hbar_j, I hbar_j) (lumped),
 
-comes from the vectorised reference of the model,
-:func:`beltsim.physics.reference.linearisation` (C = -df/dq', K = -df/dq, sparse), which
-the tests check against the numba kernel's Jacobian. The friction enters through its
-slope at the steady slip velocities (an exact law's through the stuck nodes' penalty
-slope). A perturbation y = y0 + z e^{lambda t} solves (M lambda^2 + C lambda + K) z = 0;
-the eigenvalues lambda are those of the companion matrix [[0, 1], [-M^-1 K, -M^-1 C]]
-(4 (N - 1) of them).
+comes from the numba kernel's Jacobian (:func:`beltsim.solvers.linearise.linearisation`),
+which the tests check against the vectorised reference
+(:func:`beltsim.physics.reference.linearisation`) and against transients started on a
+mode. The friction enters through its slope at the steady slip velocities (an exact
+law's through the stuck nodes' penalty slope). A perturbation y = y0 + z e^{lambda t}
+solves (M lambda^2 + C lambda + K) z = 0. On the open layout the eigenvalues are those of
+the companion matrix [[0, 1], [-M^-1 K, -M^-1 C]] (4 (N - 1) of them); a loop's globals
+are first-order unknowns and its gauge row algebraic, so its M is singular and the
+eigenvalues are the finite ones of the pencil (:func:`pencil`, the QZ algorithm).
 
 How the largest real part is found (:func:`growth_rate`):
 
-* grids up to DENSE_ELEMENTS elements: every eigenvalue, dense (LAPACK; its cost grows
-  as the cube of the grid);
-* finer grids: the dense spectrum of the same scene on DENSE_ELEMENTS elements gives the
+* grids up to DENSE_ELEMENTS elements (a loop's: DENSE_LOOP_ELEMENTS): every
+  eigenvalue, dense (LAPACK; its cost grows as the cube of the grid);
+* finer grids: the dense spectrum of the same scene on that many elements gives the
   candidate modes, then ARPACK in shift-invert mode finds the NEAREST eigenvalues of the
   fine grid around each. This can miss a mode that is unstable on the fine grid only
   (the coarse grid's upwind gyroscopic term damps more), so it errs towards "stable",
@@ -36,12 +39,13 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from . import continuum, reference
-from .friction import is_exact
-from .model import State, model_params
+from . import continuum
+from .model import State
 
-#: Up to this many elements the spectrum is computed whole (dense); above, see above.
+#: Up to this many elements the spectrum is computed whole (dense); above, see above. A
+#: loop's pencil needs the QZ algorithm, about four times the cost: 8 s on 250 elements.
 DENSE_ELEMENTS = 500
+DENSE_LOOP_ELEMENTS = 200
 #: Eigenvalues ARPACK finds around each candidate on a fine grid, and the candidates:
 #: the coarse grid's least stable modes.
 NEAREST = 12
@@ -51,6 +55,9 @@ CANDIDATES = 4
 #: a few kilohertz; and the seeds kept: real parts above SEED_FLOOR (1/s).
 SEED_ELEMENTS = 600
 SEED_FLOOR = -400.0
+#: A loop's pencil: eigenvalues beyond this many times the grid's highest frequency are
+#: its infinite ones (beta = 0 in round-off)
+INFINITE = 1e6
 
 
 @dataclass(frozen=True)
@@ -72,25 +79,34 @@ class Growth:
 
 
 def linearisation(disc, state: State):
-    """(M, C, K) of the semi-discrete model about the steady `state` (sparse; M diagonal),
-    from :func:`beltsim.physics.reference.linearisation`."""
-    from ..problem.drive import Drive
+    """(M, C, K) of the semi-discrete model about the steady ``state`` on either layout
+    (sparse), from the kernel's Jacobian (:func:`beltsim.solvers.linearise.linearisation`,
+    which the tests check against the vectorised reference)."""
+    from ..solvers.linearise import linearisation as kernel_linearisation
 
-    P, num = disc.params, disc.numerics
-    # the scene's own damping: numerics.acceleration belongs to the pseudo scheme's path
-    p = model_params(P, P.damping, num.friction_scale, num.regularisation, num.law_code,
-                     num.gyro_code)
-    rest = np.zeros_like(state.u)
-    return reference.linearisation(state.u, state.theta, rest, rest, 0.0, disc.mesh, p,
-                                   Drive.constant(P.v - P.c),
-                                   ratios=state.lam if is_exact(p.law) else None)
+    return kernel_linearisation(disc, state)
 
 
 def companion(M, C, K):
-    """The first-order system matrix [[0, 1], [-M^-1 K, -M^-1 C]] (sparse)."""
+    """The first-order system matrix [[0, 1], [-M^-1 K, -M^-1 C]] (sparse; M diagonal and
+    positive: an open layout's)."""
     n = K.shape[0]
     minv = sp.diags(1.0 / M.diagonal())
     return sp.bmat([[None, sp.identity(n)], [-minv @ K, -minv @ C]], format="csc")
+
+
+def pencil(M, C, K):
+    """(A, B): the first-order form A x = lambda B x of M z'' + C z' + K z = 0, x = (z, z')
+    (sparse). With a diagonal positive M, B is None (the identity) and A the companion
+    matrix; a loop's globals have no mass (first-order unknowns) and its gauge row is
+    algebraic, so its B is singular and the pencil has infinite eigenvalues besides the
+    model's."""
+    n = K.shape[0]
+    if M.nnz == n and np.all(M.diagonal() > 0.0):
+        return companion(M, C, K), None
+    A = sp.bmat([[None, sp.identity(n)], [-K, -C]], format="csc")
+    B = sp.bmat([[sp.identity(n), None], [None, M]], format="csc")
+    return A, B
 
 
 def _largest(eigs) -> complex:
@@ -125,12 +141,25 @@ def steady_scene(scene):
 
 
 def spectrum(disc, state) -> np.ndarray:
-    """Every eigenvalue of the linearisation (dense; small grids)."""
-    A = companion(*linearisation(disc, state)).toarray()
-    return scipy.linalg.eigvals(A, overwrite_a=True, check_finite=False)
+    """Every finite eigenvalue of the linearisation (dense; small grids)."""
+    A, B = pencil(*linearisation(disc, state))
+    if B is None:
+        return scipy.linalg.eigvals(A.toarray(), overwrite_a=True, check_finite=False)
+    alpha, beta = scipy.linalg.eigvals(A.toarray(), B.toarray(), homogeneous_eigvals=True,
+                                       overwrite_a=True, check_finite=False)
+    # B's null space (a loop's massless globals and gauge) gives beta = 0, or round-off
+    # of it: eigenvalues beyond INFINITE times the grid's highest frequency
+    finite = np.abs(beta) * INFINITE * _highest(disc) > np.abs(alpha)
+    return alpha[finite] / beta[finite]
 
 
-def growth_rate(scene, dense_elements=DENSE_ELEMENTS) -> Growth:
+def _highest(disc) -> float:
+    """The grid's highest axial frequency (rad/s), sqrt(b1 / rho) / h."""
+    P = disc.params
+    return math.sqrt(P.b1 / P.rho) / float(np.min(disc.mesh.he))
+
+
+def growth_rate(scene, dense_elements=None) -> Growth:
     """The largest real part of the eigenvalues of the scene's discrete model (its own
     grid, numerics.elements or the default) linearised about its steady state.
 
@@ -140,30 +169,39 @@ def growth_rate(scene, dense_elements=DENSE_ELEMENTS) -> Growth:
         raise ValueError("a quasistatic scene has no dynamics to linearise")
     disc, state = steady_discretisation(scene)
     N = disc.grid.n_elements
+    if dense_elements is None:
+        dense_elements = DENSE_LOOP_ELEMENTS if disc.closed else DENSE_ELEMENTS
     if N <= dense_elements:
         return _growth(_largest(spectrum(disc, state)), N, "dense")
     cdisc, cstate = steady_discretisation(scene, dense_elements)
     eigs = spectrum(cdisc, cstate)
     coarse = _growth(_largest(eigs), dense_elements, "dense")
-    A = companion(*linearisation(disc, state))
-    found = [eigenvalues_near(A, sigma, NEAREST) for sigma in _candidates(eigs, CANDIDATES)]
+    A, B = pencil(*linearisation(disc, state))
+    found = [eigenvalues_near(A, sigma, NEAREST, B) for sigma in _candidates(eigs, CANDIDATES)]
     return _growth(_largest(np.concatenate(found)), N,
                    f"shift-invert near the {dense_elements}-element grid's least stable "
                    f"modes", coarse)
 
 
-def eigenvalues_near(A, sigma, k=1) -> np.ndarray:
-    """The k eigenvalues of the companion matrix A (:func:`companion`) nearest to sigma
-    (ARPACK in shift-invert mode)."""
-    return spla.eigs(A.astype(complex), k=k, sigma=sigma, which="LM",
-                     return_eigenvectors=False, tol=1e-10, maxiter=5000)
+def eigenvalues_near(A, sigma, k=1, B=None) -> np.ndarray:
+    """The k eigenvalues of A x = lambda B x (:func:`pencil`; B None: the identity) nearest
+    to sigma: ARPACK on (A - sigma B)^-1 B, whose largest eigenvalues mu are
+    1 / (lambda - sigma)."""
+    if B is None:
+        return spla.eigs(A.astype(complex), k=k, sigma=sigma, which="LM",
+                         return_eigenvectors=False, tol=1e-10, maxiter=5000)
+    lu = spla.splu((A - sigma * B).astype(complex).tocsc())
+    Bc = B.astype(complex)
+    op = spla.LinearOperator(A.shape, matvec=lambda x: lu.solve(Bc @ x), dtype=complex)
+    mu = spla.eigs(op, k=k, which="LM", return_eigenvectors=False, tol=1e-10, maxiter=5000)
+    return sigma + 1.0 / mu
 
 
 def nearest_eigenvalue(scene, target, elements=None) -> complex:
     """The eigenvalue nearest to ``target`` of the scene's discrete model (its grid, or
     ``elements``) linearised about its steady state."""
-    A = companion(*linearisation(*steady_discretisation(scene, elements)))
-    return complex(eigenvalues_near(A, target)[0])
+    A, B = pencil(*linearisation(*steady_discretisation(scene, elements)))
+    return complex(eigenvalues_near(A, target, 1, B)[0])
 
 
 def _candidates(eigs, k):

@@ -66,7 +66,7 @@ class CellStatus(enum.StrEnum):
 #: unstable steady state is a reason the model itself gives, with its growth rate).
 ACCEPTED = (CellStatus.CONVERGED, CellStatus.BOUNDED, CellStatus.REFUSED,
             CellStatus.NOT_APPLICABLE, CellStatus.UNSTABLE, CellStatus.OUTCOME)
-#: A growth rate counts as unstable above this fraction of max(|lambda|, c / L): growth
+#: A growth rate counts as unstable above this fraction of max(|lambda|, 1 / transit): growth
 #: of at least 1e-3 per radian of the mode's oscillation and per transit (far above
 #: the eigensolver's round-off).
 GROWTH_MARGIN = 1e-3
@@ -312,8 +312,8 @@ def _stability_verdict(scene) -> tuple[bool, str, float]:
         g = growth_rate(scene)
     except Exception as exc:  # noqa: BLE001  no verdict leaves the cell as it was
         return False, f"no linear stability verdict ({type(exc).__name__}: {exc})", 0.0
-    P = scene.params
-    margin = GROWTH_MARGIN * max(math.hypot(g.rate, 2 * math.pi * g.frequency), P.c / P.L)
+    transit = solvers.discretise(scene).window  # either layout's
+    margin = GROWTH_MARGIN * max(math.hypot(g.rate, 2 * math.pi * g.frequency), 1.0 / transit)
     if g.rate > margin:
         return True, (f"the steady state is linearly unstable: {g.describe()} on this grid "
                       f"({g.elements} elements), so no run can settle: the model flutters"), 0.0

@@ -1,0 +1,104 @@
+"""The discrete model of any layout linearised about a steady state, from the numba kernel.
+
+About a steady state y0 (zero rates) the kernel's backward-Euler Jacobian
+(:func:`beltsim.physics.model.assemble`) at step rate s = 1/dt is a quadratic in s,
+
+    J(s) = s^2 M + s C + K,
+
+over the unknowns z = (u_1, theta_1, u_2, theta_2, ..., g): M the lumped masses, C the
+damping, gyroscopic and friction-rate terms (a loop's c_t in its axial rows, each free
+pulley's J omega_t), K the rest. The semi-discrete model linearised about y0 is then
+M z'' + C z' + K z = 0 on every layout: a loop's globals are first-order unknowns (no
+column of M) and its gauge row is algebraic (no row of M or C). J is evaluated at three
+rates and the quadratic read off; the rates are chosen where s^2 M and K are of one size,
+so that no part is lost in round-off.
+
+The exact laws' stuck nodes enter with the penalty slope of
+:func:`beltsim.physics.model.add_stick_penalty` (a stiff viscous stand-in for v_rel = 0),
+sliding nodes with the slope of their bound, as the straight belt's vectorised reference
+(:func:`beltsim.physics.reference.linearisation`) has it; the tests compare the two.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..physics.friction import is_exact
+from ..physics.model import add_stick_penalty, assemble
+from .newton import Workspace
+
+#: A part's entry below this fraction of its row's largest term in J(3 sigma) is
+#: round-off of the quadratic's reading (about 30 ulp of the largest term)
+ROUND_OFF = 1e-14
+
+
+def jacobian_matrix(w: Workspace, closed: bool) -> sp.csr_matrix:
+    """The Jacobian the kernel left in ``w`` as one sparse matrix over (u, theta, g):
+    its block bands (wrapping round a loop) and a loop's border."""
+    n, ng = w.Db.shape[0], w.Gd.shape[0] if closed else 0
+    rows, cols, vals = [], [], []
+    i = np.arange(n)
+    for band, o in ((w.L2, -2), (w.Lb, -1), (w.Db, 0), (w.Ub, 1)):
+        q = i + o
+        keep = slice(None) if closed else (q >= 0) & (q < n)
+        q = q % n
+        for a in range(2):
+            for b in range(2):
+                rows.append(2 * i[keep] + a)
+                cols.append(2 * q[keep] + b)
+                vals.append(band[keep, a, b])
+    if ng:
+        for a in range(2):
+            for k in range(ng):
+                rows += [2 * i + a, np.full(n, 2 * n + k)]
+                cols += [np.full(n, 2 * n + k), 2 * i + a]
+                vals += [w.Gc[:, a, k], w.Gr[k, :, a]]
+        gk = np.arange(ng)
+        rows.append(np.repeat(2 * n + gk, ng))
+        cols.append(np.tile(2 * n + gk, ng))
+        vals.append(w.Gd.ravel())
+    size = 2 * n + ng
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(size, size))
+
+
+def linearisation(disc, state):
+    """(M, C, K) of the layout's semi-discrete model about its steady ``state`` (sparse,
+    over (u, theta) of each unknown node, then the globals), with the scene's own damping
+    (numerics.acceleration belongs to the pseudo scheme's path)."""
+    P = disc.params
+    # the primal form: the Jacobian is then the residual's whole derivative
+    p = disc.model._replace(damping=P.damping, dual=0)
+    old = state._replace(ud=np.zeros_like(state.ud), td=np.zeros_like(state.td),
+                         gd=np.zeros_like(state.gd))
+    drive = disc.steady_drive()
+    w = Workspace.allocate(disc.grid.n_elements, is_exact(p.law), disc.closed,
+                           disc.n_globals)
+    fnode = np.zeros_like(state.u)
+    # s where s^2 rho h and b1 / h balance: the grid's highest axial frequency
+    h = float(np.min(disc.mesh.he))
+    stiff = P.b1 if disc.closed else p.B
+    sigma = np.sqrt(stiff / max(P.rho, 1e-300)) / h if P.rho > 0 else 1.0 / h
+    J = []
+    for s in (sigma, 2.0 * sigma, 3.0 * sigma):
+        assemble(state.u.copy(), state.theta.copy(), state.lam.copy(), state.g.copy(), fnode,
+                 old, s, 0.0, disc.mesh, p, drive, disc.loads, w, True)
+        if is_exact(p.law):
+            c = state.g[0] if disc.closed else p.speed
+            add_stick_penalty(w, s, p.friction_scale, c, disc.mesh, p)
+        J.append(jacobian_matrix(w, disc.closed))
+    second = (J[2] - 2.0 * J[1] + J[0]) / 2.0
+    first = J[1] - J[0] - 3.0 * second
+    zero = ROUND_OFF * abs(J[2]).max(axis=1).toarray().ravel()
+    return tuple(_clean(part / scale, zero / scale)
+                 for part, scale in ((second, sigma * sigma), (first, sigma),
+                                     (J[0] - first - second, 1.0)))
+
+
+def _clean(A, zero) -> sp.csr_matrix:
+    """A without the entries below its rows' round-off ``zero`` (a loop's globals have
+    no mass: their rows and columns of M must be empty, not 1e-19)."""
+    A = sp.coo_matrix(A)
+    keep = np.abs(A.data) > zero[A.row]
+    return sp.csr_matrix((A.data[keep], (A.row[keep], A.col[keep])), shape=A.shape)
