@@ -16,6 +16,7 @@ from beltsim.studies.stability import steady_state_stability
 from helpers import scene_path
 
 PAPER = open(scene_path("paper_slip")).read()
+DRIVE = open(scene_path("drive_flat")).read()
 
 CORPUS = {
     "malformed": ("[beam\nlength = 1", "malformed TOML"),
@@ -62,6 +63,21 @@ CORPUS = {
     "explicit central": (PAPER + '\n[numerics]\ngyroscopic = "central"\n'
                          'integrator = "explicit"\n',
                          'numerics.gyroscopic: "central" is for the implicit schemes'),
+    # the closed drive's layout, through the same command line
+    "drive wrong type": (DRIVE.replace("driver_radius = 0.08", 'driver_radius = "small"'),
+                         "drive.driver_radius: must be a number"),
+    "drive overlap": (DRIVE.replace("centre_distance = 0.6", "centre_distance = 0.2"),
+                      "drive.centre_distance"),
+    "drive unknown key": (DRIVE.replace("[drive]", "[drive]\npulleys = 3"),
+                          "drive.pulleys: unknown key"),
+    "drive lift-off": (DRIVE.replace("installation_tension = 600.0",
+                                     "installation_tension = 5.0"),
+                       "drive.installation_tension"),
+    "drive table order": (DRIVE.replace("load_torque = 50.0",
+                                        "load_torque = [[0, 1], [0, 2]]"),
+                          "drive.load_torque row 2"),
+    "drive nan": (DRIVE.replace("density = 1200.0", "density = nan"),
+                  "belt.density: must be finite"),
 }
 
 
