@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from beltsim.beltdrive.scene import DriveScene
-from beltsim.physics.model import Loads
+from beltsim.physics.discrete import Loads
 from beltsim.problem.drive import Drive
 from beltsim.solvers import LoopDiscretisation
 from beltsim.solvers.newton import NewtonSettings, Workspace, newton

@@ -16,8 +16,9 @@ import pytest
 
 from beltsim.beltdrive.scene import DriveScene
 from beltsim.physics import reference
+from beltsim.physics.discrete import CENTRAL, UPWIND, Loads, State
 from beltsim.physics.layout import LoopGrid
-from beltsim.physics.model import CENTRAL, UPWIND, Loads, State, assemble
+from beltsim.physics.model import assemble
 from beltsim.problem.drive import Drive, Profile
 from beltsim.solvers import LoopDiscretisation
 from beltsim.solvers.newton import Workspace

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import beltsim
+from beltsim.physics.discrete import mesh_of
 from beltsim.physics.friction import ADHESION, EXACT
-from beltsim.physics.model import mesh_of
 from beltsim.physics.reference import strain
 from beltsim.problem.scene import Scene
 from beltsim.solvers.explicit import _friction_scalar

@@ -11,8 +11,8 @@ from scipy.optimize import brentq
 import beltsim
 from beltsim.beltdrive.scene import max_rim_speed
 from beltsim.physics import reference
+from beltsim.physics.discrete import Loads, State
 from beltsim.physics.friction import law_numpy
-from beltsim.physics.model import Loads, State
 from beltsim.problem.drive import mismatch, value
 from beltsim.problem.scene import Scene
 from beltsim.simulation.controller import Simulation

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from beltsim.physics import reference
+from beltsim.physics.discrete import CENTRAL, UPWIND, Loads, State, hermite_weights, load_at
 from beltsim.physics.friction import (
     ADHESION,
     EXACT,
@@ -18,16 +19,10 @@ from beltsim.physics.friction import (
 )
 from beltsim.physics.grid import bisect, make_grid
 from beltsim.physics.model import (
-    CENTRAL,
     POWER_TERMS,
-    UPWIND,
-    Loads,
-    State,
     add_stick_penalty,
     assemble,
     blocks_to_dense,
-    hermite_weights,
-    load_at,
     power_terms,
     rate_part,
     update_multipliers,

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from beltsim.api import load_scene
+from beltsim.physics.discrete import Loads, State
 from beltsim.physics.friction import LAW_CODES
 from beltsim.physics.layout import LoopGrid, loop_mesh, loop_params
-from beltsim.physics.model import Loads, State, assemble
+from beltsim.physics.model import assemble
 from beltsim.problem.drive import Drive, Profile
 from beltsim.solvers.newton import Workspace, factorise, linear_solve
 from beltsim.solvers.ssn import saddle_solve, saddle_system

@@ -16,8 +16,8 @@ import pytest
 
 import beltsim
 from beltsim.physics import reference
+from beltsim.physics.discrete import Loads
 from beltsim.physics.friction import law_numpy
-from beltsim.physics.model import Loads
 from beltsim.problem.drive import friction_factor, mismatch
 from helpers import scene_path
 

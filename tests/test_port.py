@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from beltsim.api import load_scene
-from beltsim.physics.model import Loads
+from beltsim.physics.discrete import Loads
 from beltsim.simulation.controller import Simulation
 from benchmarks import port
 from helpers import scene_path

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 import beltsim
+from beltsim.physics.discrete import State
 from beltsim.physics.grid import make_grid
-from beltsim.physics.model import State
 from beltsim.solvers import Discretisation, steady
 from beltsim.solvers.settings import DEFAULT_ELEMENTS
 from helpers import scene_path

@@ -77,7 +77,7 @@ def test_peer_rhs_is_the_semi_discrete_model():
     n = peer.n
     y = 1e-4 * rng.standard_normal(4 * n)
     f = peer.rhs(0.3, y)
-    from beltsim.physics.model import State
+    from beltsim.physics.discrete import State
     from beltsim.physics.reference import residual
     dt = 1e-3
 

@@ -3,9 +3,9 @@
 A layout is a sequence of segments along the belt (a free span; contact with a moving
 plate of prescribed speed, the paper's; contact on a pulley's arc) and a closure: open,
 with the material entering at x = 0 and leaving at x = L at the speed c (the paper's
-control domain, :func:`beltsim.physics.model.mesh_of`), or a closed loop, whose belt
+control domain, :func:`beltsim.physics.discrete.mesh_of`), or a closed loop, whose belt
 speed c and free pulleys' speeds are global unknowns of the model (:func:`loop_mesh`).
-Both come out as a :class:`~beltsim.physics.model.Mesh`: the kernels, the schemes and the
+Both come out as a :class:`~beltsim.physics.discrete.Mesh`: the kernels, the schemes and the
 linear solve read nothing else.
 
 The two-pulley loop, in the loop coordinate x in [0, Lambda) of the belt's motion:
@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import UPWIND, Mesh, ModelParams
+from .discrete import UPWIND, Mesh, ModelParams
 
 #: The fewest elements on each of a loop's segments.
 MIN_SEGMENT_ELEMENTS = 4

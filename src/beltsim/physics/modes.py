@@ -40,7 +40,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from . import continuum
-from .model import State
+from .discrete import State
 
 #: Up to this many elements the spectrum is computed whole (dense); above, see above. A
 #: loop's pencil needs the QZ algorithm, about four times the cost: 8 s on 250 elements.

@@ -32,8 +32,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..problem.drive import friction_factor, mismatch, value
+from .discrete import CENTRAL, Mesh, ModelParams, State, hermite_weights
 from .friction import ADHESION, AUGMENTATION, is_exact, law_numpy
-from .model import CENTRAL, POWER_TERMS, Mesh, ModelParams, State, hermite_weights
+from .model import POWER_TERMS
 
 
 class Operators(NamedTuple):

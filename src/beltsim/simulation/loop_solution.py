@@ -38,7 +38,7 @@ class LoopSolution:
     ----------
     disc : beltsim.solvers.base.LoopDiscretisation
         The drive on its grid.
-    state : beltsim.physics.model.State
+    state : beltsim.physics.discrete.State
         The state (copied).
     t : float or None
         Its time, for the drive's profiles (None: a steady state, the final values).
@@ -218,7 +218,7 @@ class LoopSolution:
         """What snapshots.npz holds of a run's snapshots: u, theta, the traction, the
         axial force and the sliding nodes (times, nodes), and the belt's and the driven
         pulley's speeds (times)."""
-        from ..physics.model import State
+        from ..physics.discrete import State
 
         out = {k: [] for k in ("u", "theta", "friction", "tension", "slip", "belt_speed",
                                "driven_speed")}

@@ -3,7 +3,7 @@
 How the analytic quantities are read off the discrete state:
 
 * the nodal friction forces F_j (N) sit on the friction nodes of the contact
-  (physics.model.contact_stencil), the traction f_j = F_j / wf_j;
+  (physics.discrete.contact_stencil), the traction f_j = F_j / wf_j;
   ``total_friction`` is their sum;
 * perfect adhesion: the concentrated force is what the last three friction nodes
   (ending at x2) carry beyond the distributed traction, extrapolated (quadratic)
@@ -21,9 +21,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..physics.discrete import contact_stencil
 from ..physics.friction import saturation
 from ..physics.grid import Grid
-from ..physics.model import contact_stencil, traction
+from ..physics.model import traction
 from ..physics.reference import strain
 from ..problem.analytic import AnalyticSolution
 from ..problem.validation import Params
@@ -69,7 +70,7 @@ class DiscreteSolution:
         self.friction_scale = friction_scale
         # v(t) - c at the state's time (the drive's final value by default)
         self.mismatch = params.v - params.c if mismatch is None else float(mismatch)
-        # the friction nodes, their weights and slip-velocity stencils (physics.model;
+        # the friction nodes, their weights and slip-velocity stencils (physics.discrete;
         # a run passes its mesh's rather than rebuild them at every check)
         self.c0, self.wf, self.sw = (contact_stencil(grid.x, grid.j1, grid.j2)
                                      if stencil is None else stencil)
@@ -196,7 +197,7 @@ class DiscreteSolution:
         """The friction law's dissipation now, -sum F_j v_rel,j over the contact nodes (W).
 
         The numpy twin of the "slip" term of physics.model.power_terms, v_rel read the
-        same way (the nodal stencil of physics.model.contact_stencil). v_rel / c =
+        same way (the nodal stencil of physics.discrete.contact_stencil). v_rel / c =
         eps_b - e0 is a small difference of the strains, so its relative error is large;
         and a perfect-adhesion layer, far thinner than an element, does not show its
         dissipation here at all.

@@ -8,10 +8,10 @@ from typing import ClassVar, NamedTuple
 
 import numpy as np
 
+from ..physics.discrete import Loads, Mesh, ModelParams, State, mesh_of, model_params
 from ..physics.friction import EXACT, LINEAR, has_dual
 from ..physics.grid import Grid
 from ..physics.layout import LoopGrid, loop_mesh, loop_params
-from ..physics.model import Loads, Mesh, ModelParams, State, mesh_of, model_params
 from ..problem.drive import Drive, Profile, as_profile, drive_of
 from ..problem.scene import Scene
 from .settings import Numerics, build_grid, resolve, resolve_loop

@@ -24,7 +24,7 @@ enormous, so the velocity it sees must damp the friction relaxation (the mean of
 velocities before and after the kick, trapezoidal, rings with amplification -1 and,
 with the transport term, diverges in stick) yet be second order (the velocity after
 the kick, backward Euler, is first order). The slip velocity of node j (c0 .. j2, the
-model's friction nodes, physics.model.contact_stencil) is taken as
+model's friction nodes, physics.discrete.contact_stencil) is taken as
 
     b_before + A_EST delta_j - C_EST delta_j^{n-1}
     + c sum_k sw[j, k] (ub_k + ALPHA dt delta_k) - (v - c),   k = j-2, j-1, j
@@ -60,8 +60,8 @@ import numpy as np
 from numba import njit
 
 from ..errors import SceneError
+from ..physics.discrete import hermite_weights, load_at
 from ..physics.friction import SQRT, TANH
-from ..physics.model import hermite_weights, load_at
 from ..problem.drive import friction_factor, mismatch
 from .base import Scheme
 from .explicit_friction import (  # noqa: F401 (the scheme's constants and solves, as tests read them)
@@ -123,7 +123,7 @@ _1, _2 = np.uint64(1), np.uint64(2)
 # sweep reads them from one pointer (as 11 arrays their pointers spilled to the stack)
 FR_EST = 0  # A_EST + ALPHA dt c sw[j, 2]: this kick's increment at j in the estimate
 FR_T0, FR_T1, FR_T2 = 1, 2, 3  # c sw[j, 0..2], the transport c d/dx u_b at node j from
-# u_b at j-2, j-1, j (mesh.sw, physics.model.contact_stencil)
+# u_b at j-2, j-1, j (mesh.sw, physics.discrete.contact_stencil)
 FR_A0, FR_A1 = 4, 5  # ALPHA dt c sw[j, 0..1]: the transport of the increments at j-2, j-1
 FR_FH = 6  # wf_j f_s: the node's friction weight times the friction scale
 FR_FM, FR_FI = 7, 8  # dt / m_j, dt (h/2) / m_I,j: a nodal force's kick

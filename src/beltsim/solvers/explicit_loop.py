@@ -3,7 +3,7 @@
 :mod:`beltsim.solvers.explicit` describes the step: the velocity terms (gyroscopic and
 damping) by the trapezoidal rule with the drift, then the kick with friction implicit in
 each friction node's own velocity, swept in the direction of the flow. On a loop
-(``mesh.off`` = 0, :class:`beltsim.physics.model.Mesh`) three things differ.
+(``mesh.off`` = 0, :class:`beltsim.physics.discrete.Mesh`) three things differ.
 
 * Periodic sweeps. The velocity system (2/dt + d + G) vm = (2/dt) v_a is lower
   bidiagonal with one entry across the closure: cyclic. Its solution is one pass from
@@ -49,8 +49,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..physics.discrete import hermite_weights, load_at
 from ..physics.friction import ADHESION, EXACT, LINEAR, RAMP, SQRT, TANH
-from ..physics.model import hermite_weights, load_at, wrap
+from ..physics.model import wrap
 from ..problem.drive import friction_factor, value
 from .explicit_friction import A_EST, ALPHA, C_EST, SAFE_FASTMATH, _friction_scalar, _law
 

@@ -18,7 +18,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ..physics.model import contact_stencil
+from ..physics.discrete import contact_stencil
 from .explicit_friction import A_EST, ALPHA, C_EST
 
 # friction slopes of the von Neumann analysis, as dt k (1/rho + (h/2)^2 / I): the
@@ -35,7 +35,7 @@ def _gyro_symbol(c, h, kh):
 
 def _transport_symbol(c, h, kh):
     """c d/dx of the slip velocity on a uniform grid (1/s), for the mode e^{i kh j}: the
-    model's stencil (physics.model.contact_stencil) read at an inner contact node of a
+    model's stencil (physics.discrete.contact_stencil) read at an inner contact node of a
     uniform grid: (3 - 4 e^{-i kh} + e^{-2 i kh}) / (2 h)."""
     _, _, sw = contact_stencil(h * np.arange(8.0), 2, 6)
     return c * sum(sw[4, o] * np.exp(1j * kh * (o - 2)) for o in range(3))

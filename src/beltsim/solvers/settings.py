@@ -28,9 +28,9 @@ import math
 from dataclasses import dataclass
 
 from ..errors import SceneError
+from ..physics.discrete import GYROSCOPIC_FORMS
 from ..physics.friction import AUGMENTATION, LAW_CODES, is_exact
 from ..physics.grid import Grid, make_grid
-from ..physics.model import GYROSCOPIC_FORMS
 from ..problem import analytic
 from ..problem.analytic import decay_rates
 from ..problem.drive import largest_mismatch, period_of, profile_times, speed_ramped
@@ -93,7 +93,7 @@ class Numerics:
     time_tol: float = DEFAULT_TIME_TOL
     max_work: float = DEFAULT_MAX_WORK
     settle_time: float = 0.0  # when the drive stops changing (steady tests start there)
-    gyroscopic: str = "upwind"  # the gyroscopic term's form (physics.model.GYROSCOPIC_FORMS)
+    gyroscopic: str = "upwind"  # the gyroscopic term's form (physics.discrete.GYROSCOPIC_FORMS)
 
     @property
     def gyro_code(self) -> int:

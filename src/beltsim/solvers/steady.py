@@ -25,10 +25,10 @@ import numpy as np
 
 from ..beltdrive.analytic import creep_speed, solve_string
 from ..errors import FailureKind, NumericalError
+from ..physics.discrete import Loads, mesh_of, regularised
 from ..physics.friction import EXACT, TANH, is_exact
 from ..physics.grid import Grid
 from ..physics.layout import LoopGrid
-from ..physics.model import Loads, mesh_of, regularised
 from .newton import NewtonScheme, NewtonSettings, newton
 from .registry import register
 from .settings import LOOP_ELEMENTS, LOOP_REGULARISATION, default_elements
@@ -123,7 +123,7 @@ class SteadyScheme(NewtonScheme):
     def _solve_from_rest(self, state) -> None:
         """Continuation in v - c (after one in v_reg for a saturating law); the number of
         stages is counted as steps. An exact law first solves its regularised twin
-        (physics.model.regularised) so, and then itself from there at full speed: the
+        (physics.discrete.regularised) so, and then itself from there at full speed: the
         semi-smooth Newton cycles from rest, where every node's stick/slip state is
         wrong, and converges from the twin's (a few iterations).
         """
