@@ -1,9 +1,23 @@
-"""Paths and command runners shared by the tests, independent of the working directory."""
+"""Paths and command runners shared by the tests, independent of the working directory;
+error bounds; and the one discrete model's two layouts as the kernel tests build them."""
 
 import subprocess
 import sys
 from importlib.resources import files
 from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from beltsim.beltdrive.scene import DriveScene
+from beltsim.physics import reference
+from beltsim.physics.discrete import GYROSCOPIC_FORMS, Loads, Mesh, ModelParams, State
+from beltsim.physics.friction import ADHESION, EXACT, LINEAR, RAMP, SQRT, TANH, is_exact
+from beltsim.physics.model import JACOBIAN, assemble
+from beltsim.problem.drive import Drive, Profile
+from beltsim.problem.scene import Scene
+from beltsim.solvers import Discretisation, LoopDiscretisation
+from beltsim.solvers.newton import Workspace
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -51,3 +65,213 @@ def assert_errors_near(result, measured: dict, factor: float = ERROR_FACTOR):
     assert set(errors) == set(measured), (sorted(errors), sorted(measured))
     for key, value in errors.items():
         assert value <= factor * measured[key], (key, value, measured[key])
+
+
+# -- the one discrete model on either layout, as the kernel tests build it -------------
+# A layout's mesh, coefficients, drive and loads, and a random trial state with a
+# previous step's: what the tests hand to physics.model.assemble and to physics.reference
+# (reference.residual on the straight belt, reference.loop_residual on the loop).
+
+#: The layouts of the one model: the paper's open belt and the closed two-pulley drive.
+LAYOUTS = ("straight", "loop")
+
+#: The straight belt's friction laws by name (the loop's scene takes tanh, sqrt and
+#: exact, and adhesion as a "stick" contact).
+LAWS = {"linear": LINEAR, "tanh": TANH, "sqrt": SQRT, "ramp": RAMP, "exact": EXACT,
+        "adhesion": ADHESION}
+
+#: a backward-Euler step's 1 / dt, or 0 (the steady problem), on each layout: the loop's
+#: dt = 2e-4 s is about a thousandth of its belt's transit time
+INV_DT = {"straight": 3e3, "loop": 1.0 / 2e-4}
+
+#: The loop's drive: rim speed, friction factor and load torque.
+LOOP_DRIVE = Drive(Profile.constant(12.1), Profile.constant(0.9), Profile.constant(40.0))
+
+
+class KernelCase(NamedTuple):
+    """A layout at time t with a random trial state (u, theta, lam: all the nodes; g: a
+    loop's global unknowns) and a previous step's ``old``; ``m``: the magnitudes of the
+    unknowns, in the order of :func:`unknowns`."""
+
+    layout: str
+    mesh: Mesh
+    p: ModelParams
+    drive: Drive
+    loads: Loads
+    t: float
+    u: np.ndarray
+    th: np.ndarray
+    lam: np.ndarray
+    g: np.ndarray
+    old: State
+    inv_dt: float
+    m: np.ndarray
+    disc: object  # the Discretisation or LoopDiscretisation it was built from
+
+
+def random_loads(n_nodes, seed):
+    """Random distributed loads on ``n_nodes`` nodes, tabulated at three times."""
+    rng = np.random.default_rng(seed)
+    return Loads(np.array([0.0, 0.004, 0.01]),
+                 *(1e3 * rng.standard_normal((3, n_nodes)) for _ in range(4)))
+
+
+def straight_state(n_nodes, seed, amp):
+    """(u, theta, old): a random trial state of the straight belt and a previous step's
+    (values and local velocities), of size ``amp`` and zero at both ends."""
+    rng = np.random.default_rng(seed)
+    arrs = [amp * rng.standard_normal(n_nodes) for _ in range(6)]
+    for a in arrs:
+        a[0] = a[-1] = 0.0
+    u, th, uo, tho, udo, tdo = arrs
+    zero = np.zeros(n_nodes)
+    return u, th, State(uo, tho, zero.copy(), udo, tdo, zero.copy())
+
+
+def kernel_case(layout, law, step, seed, gyro="upwind", inertia=True, loads=False,
+                model="beam", grid=None) -> KernelCase:
+    """``layout`` with friction ``law`` (a name), a step (``step``; else the steady
+    problem), the gyroscopic form, inertia, random loads and the string or beam model,
+    and a random state drawn from ``seed``; ``grid``: a loop's own grid."""
+    make = _straight_case if layout == "straight" else _loop_case
+    return make(law, INV_DT[layout] if step else 0.0, seed, gyro, inertia, loads, model, grid)
+
+
+def _straight_case(law, inv_dt, seed, gyro, inertia, loads, model, grid):
+    """The paper's belt on 40 elements; laws at v_reg 5 m/s (v_aug for the exact ones), so
+    that the random slip velocities (~5 m/s) fall on the steep part of the saturating laws
+    and the exact law's stick test goes both ways."""
+    assert model == "beam" and grid is None, "the straight belt is a beam on its own grid"
+    scene = Scene.load(scene_path("paper_slip")).with_overrides(
+        ["numerics.elements=40", f"physics.inertia={str(inertia).lower()}"])
+    d = Discretisation(scene)
+    p = d.model._replace(dual=0, law=LAWS[law], regularisation=5.0,
+                         gyro=GYROSCOPIC_FORMS[gyro])
+    n, amp = len(d.grid.x), 1e-4
+    u, th, old = straight_state(n, seed, amp)
+    # the exact laws' multipliers, stick and slip
+    lam = 1.5 * np.random.default_rng(seed + 100).uniform(-1.0, 1.0, n)
+    ld = random_loads(n, seed + 7) if loads else Loads.none(n)
+    return KernelCase("straight", d.mesh, p, d.drive, ld, 0.005, u, th, lam, np.zeros(0),
+                      old, inv_dt, np.full(2 * (n - 2), amp), d)
+
+
+def _loop_case(law, inv_dt, seed, gyro, inertia, loads, model, grid):
+    """drive_flat on 60 elements (about 60 nodes, 26 of them in contact); the regularised
+    laws at half the creep speed, so that the random slip velocities reach their saturated
+    part. The state's sizes are a time step's: u a strain of half N0 / b1 over an element
+    (the pressure stays positive), theta N0 / b1, the speeds within 1e-3 and 1e-2 of the
+    creep theory's."""
+    scene = DriveScene.load(scene_path("drive_flat"))
+    if law == "adhesion":
+        data = scene.to_dict()
+        data["contact"] = {"friction": "stick"}
+        scene = DriveScene.from_dict(data)
+    over = {"physics.model": model, "physics.inertia": inertia, "numerics.elements": 60,
+            "numerics.gyroscopic": gyro}
+    if law in ("tanh", "sqrt"):
+        over.update({"numerics.friction_law": law, "numerics.regularisation": 0.03})
+    d = LoopDiscretisation(scene.with_overrides(over), grid)
+    # the primal form: the kernel's Jacobian is then the residual's whole derivative
+    d.model = d.model._replace(dual=0)
+    rng = np.random.default_rng(seed)
+    P, mesh = d.params, d.mesh
+    N = len(mesh.hb)
+    strain = P.N0 / P.b1
+    rim = P.omega1 * P.geometry.R1
+    mu_, mt = 0.25 * strain * float(np.min(mesh.he)), strain
+    mg = np.array([rim, rim / P.geometry.R2])
+    u, th = mu_ * rng.uniform(-1, 1, N), mt * rng.uniform(-1, 1, N)
+    g = np.array([rim / (1.0 + strain) * (1.0 + 1e-3 * rng.uniform(-1, 1)),
+                  mg[1] * (1.0 + 1e-2 * rng.uniform(-1, 1))])
+    lam = np.where(mesh.seg >= 0, 2.0 * rng.uniform(-1, 1, N), 0.0)
+    step = INV_DT["loop"]
+    old = State(u - mu_ * rng.uniform(-1, 1, N), th - mt * rng.uniform(-1, 1, N),
+                np.zeros(N), step * mu_ * rng.uniform(-1, 1, N),
+                step * mt * rng.uniform(-1, 1, N), np.zeros(N),
+                g * (1.0 - 1e-3 * rng.uniform(-1, 1, 2)), np.zeros(2))
+    ld = random_loads(N, seed + 7) if loads else Loads.none(N)
+    return KernelCase("loop", mesh, d.model, LOOP_DRIVE, ld, 0.3, u, th, lam, g, old,
+                      inv_dt, np.concatenate([np.tile([mu_, mt], N), mg]), d)
+
+
+def unknowns(case: KernelCase) -> np.ndarray:
+    """The unknowns of the rows, (u, theta) interleaved, then the globals: the straight
+    belt's interior nodes', all the loop's nodes'."""
+    sl = slice(1, -1) if case.layout == "straight" else slice(None)
+    return np.concatenate([np.column_stack([case.u[sl], case.th[sl]]).ravel(), case.g])
+
+
+def with_unknowns(case: KernelCase, x) -> KernelCase:
+    """The case with the unknowns x (:func:`unknowns`) in place of its own."""
+    u, th = case.u.copy(), case.th.copy()
+    sl = slice(1, -1) if case.layout == "straight" else slice(None)
+    n = len(u[sl])
+    u[sl], th[sl] = x[0:2 * n:2], x[1:2 * n:2]
+    return case._replace(u=u, th=th, g=np.array(x[2 * n:]))
+
+
+def kernel_residual(case: KernelCase):
+    """(w, r, F): physics.model.assemble's workspace with the Jacobian, its residual (the
+    rows', then the globals') and the nodal friction forces."""
+    N = len(case.mesh.he)
+    closed = case.layout == "loop"
+    w = Workspace.allocate(N, False, closed, len(case.g))
+    F = np.zeros(len(case.u))
+    assemble(case.u.copy(), case.th.copy(), case.lam.copy(), case.g.copy(), F, case.old,
+             case.inv_dt, case.t, case.mesh, case.p, case.drive, case.loads, w, JACOBIAN)
+    return w, np.concatenate([w.R.ravel(), w.Rg]), F
+
+
+def reference_residual(case: KernelCase):
+    """(r, F): physics.reference's residual (the rows', then the globals') and nodal
+    friction forces; an exact law's ratios are the case's lam."""
+    if case.layout == "loop":
+        R, Rg, F = reference.loop_residual(case.u, case.th, case.lam, case.g, case.old,
+                                           case.inv_dt, case.t, case.mesh, case.p,
+                                           case.drive, case.loads)
+        return np.concatenate([R.ravel(), Rg]), F
+    ratios = case.lam if is_exact(case.p.law) else None
+    R, F = reference.residual(case.u, case.th, case.old, case.inv_dt, case.t, case.mesh,
+                              case.p, case.drive, case.loads, ratios)
+    return R.ravel(), F
+
+
+def reference_derivative(case: KernelCase, step=1e-7):
+    """Central differences of the reference's residual in the unknowns, each stepped by
+    ``step`` times its magnitude (truncation and round-off ~1e-7 of a row's terms)."""
+    x0 = unknowns(case)
+    J = np.zeros((len(x0), len(x0)))
+    for k in range(len(x0)):
+        h = step * case.m[k]
+        xp, xm = x0.copy(), x0.copy()
+        xp[k] += h
+        xm[k] -= h
+        J[:, k] = (reference_residual(with_unknowns(case, xp))[0]
+                   - reference_residual(with_unknowns(case, xm))[0]) / (2 * h)
+    return J
+
+
+def dense_jacobian(w, closed=False):
+    """The whole Jacobian of a workspace's bands (2x2 blocks, or the exact laws' 3x3) and,
+    on a loop, its global columns Gc, rows Gr and block Gd. An open layout's bands stop at
+    its ends; a loop's wrap round (row 0's Lb couples to the last node)."""
+    n, b, ng = w.Db.shape[0], w.Db.shape[1], w.Gd.shape[0]
+    J = np.zeros((b * n + ng, b * n + ng))
+    for i in range(n):
+        for band, o in ((w.L2, -2), (w.Lb, -1), (w.Db, 0), (w.Ub, 1)):
+            q = (i + o) % n if closed else i + o
+            if 0 <= q < n:
+                J[b * i:b * i + b, b * q:b * q + b] += band[i]
+        J[b * i:b * i + b, b * n:] = w.Gc[i]
+        J[b * n:, b * i:b * i + b] = w.Gr[:, i, :]
+    J[b * n:, b * n:] = w.Gd
+    return J
+
+
+def row_terms(case: KernelCase, J, r):
+    """Each row's term scale: the largest change of the row for a typical change of one
+    unknown (max_k |J_ik| m_k, m_k the state's magnitude of unknown k) or the row's value,
+    whichever is larger. The random old states are of a time step's size, so it is the
+    size of the row's largest term, and round-off is ~1e-16 of it."""
+    return np.maximum(np.max(np.abs(J) * case.m, axis=1), np.abs(r))

@@ -4,9 +4,8 @@ import numpy as np
 import pytest
 
 from beltsim.physics import reference
-from beltsim.physics.discrete import CENTRAL, UPWIND, Loads, State, hermite_weights, load_at
+from beltsim.physics.discrete import CENTRAL, UPWIND, State, hermite_weights, load_at
 from beltsim.physics.friction import (
-    ADHESION,
     EXACT,
     LAW_CODES,
     LINEAR,
@@ -22,7 +21,6 @@ from beltsim.physics.model import (
     POWER_TERMS,
     add_stick_penalty,
     assemble,
-    blocks_to_dense,
     power_terms,
     rate_part,
     update_multipliers,
@@ -37,7 +35,19 @@ from beltsim.solvers.newton import (
     block_substitute,
     newton,
 )
-from helpers import scene_path
+from helpers import (
+    LAWS,
+    LAYOUTS,
+    dense_jacobian,
+    kernel_case,
+    kernel_residual,
+    random_loads,
+    reference_derivative,
+    reference_residual,
+    row_terms,
+    scene_path,
+    straight_state,
+)
 
 pytestmark = pytest.mark.unit
 
@@ -49,18 +59,6 @@ def _setup(overrides=(), N=40, dual=0):
     return d, d.grid, d.model._replace(dual=dual)
 
 
-def _random_state(grid, seed, amp=1e-3):
-    """Trial (u, theta) and a previous step (values and local velocities)."""
-    rng = np.random.default_rng(seed)
-    n = len(grid.x)
-    arrs = [amp * rng.standard_normal(n) for _ in range(6)]
-    for a in arrs:
-        a[0] = a[-1] = 0.0
-    u, th, uo, tho, udo, tdo = arrs
-    zero = np.zeros(n)
-    return u, th, State(uo, tho, zero.copy(), udo, tdo, zero.copy())
-
-
 def _assemble(d, u, th, lam, old, inv_dt, t, p, loads=None):
     w = Workspace.allocate(d.grid.n_elements)
     fnode = np.zeros_like(u)
@@ -69,63 +67,114 @@ def _assemble(d, u, th, lam, old, inv_dt, t, p, loads=None):
     return w, fnode
 
 
-def _random_loads(n, seed):
-    rng = np.random.default_rng(seed)
-    return Loads(np.array([0.0, 0.004, 0.01]),
-                 *(1e3 * rng.standard_normal((3, n)) for _ in range(4)))
+# -- the kernel against the reference, on both layouts ----------------------------------
+# A case is (layout, law, step, gyro, inertia, loads, model): helpers.kernel_case. Every
+# law in its primal form (the kernels' primal-dual form is checked against it below).
+
+#: the kernel's agreement with the reference in the units of each row's terms
+#: (helpers.row_terms): the same terms summed in another order agree to round-off,
+#: ~1e-16 of a row's largest term; 1e-12 leaves room for the cancellation of terms up to
+#: 1e4 times the row's result
+TOL = 1e-12
+
+#: The straight belt's cases: every law, with and without inertia and loads, and the
+#: skew (central) gyroscopic form.
+STRAIGHT_CASES = [(law, step, gyro, inertia, loads, "beam")
+                  for law in LAWS for step in (False, True)
+                  for inertia, loads, gyro in ((True, True, "upwind"),
+                                               (True, False, "upwind"),
+                                               (False, True, "upwind"),
+                                               (True, False, "central"))]
+
+#: The loop's cases: its laws, the beam and the string, both gyroscopic forms.
+LOOP_CASES = [(law, step, gyro, True, False, model)
+              for law in ("tanh", "sqrt", "exact", "adhesion") for step in (False, True)
+              for model in ("beam", "string") for gyro in ("upwind", "central")]
 
 
-# Every law in its primal form (the kernels' primal-dual form is checked against it
-# below); the regularisation is set so that the random slip velocities (~5 m/s) fall on
-# the steep part of the saturating laws and the exact law's stick test goes both ways.
-LAWS = {"linear": LINEAR, "tanh": TANH, "sqrt": SQRT, "ramp": RAMP, "exact": EXACT,
-        "adhesion": ADHESION}
+def _params(layout, cases):
+    """pytest parameters (layout, *case), named after what they set."""
+    def name(law, step, gyro, inertia, loads, model):
+        return "-".join([layout, law, "step" if step else "steady", gyro,
+                         "inertia" if inertia else "quasistatic",
+                         *(["loads"] if loads else []), model])
+    return [pytest.param(layout, *case, id=name(*case)) for case in cases]
 
 
-def _kernel_and_reference(code, inertia, inv_dt, loads, seed=1, gyro=UPWIND):
-    """(kernel, reference, k) at a random state: residual, nodal friction and dense
-    Jacobian of each, and the reference's friction stiffnesses."""
-    d, grid, p = _setup([f"physics.inertia={str(inertia).lower()}"])
-    p = p._replace(law=code, regularisation=5.0, gyro=gyro)
-    u, th, old = _random_state(grid, seed, amp=1e-4)
-    rng = np.random.default_rng(seed + 100)
-    lam = 1.5 * rng.uniform(-1.0, 1.0, len(u))  # the exact laws' multipliers: stick and slip
-    t = 0.005
-    ld = _random_loads(len(u), seed + 7) if loads else Loads.none(len(u))
-    w, fnode = _assemble(d, u, th, lam, old, inv_dt, t, p, ld)
-    ratios = None
-    if code >= EXACT:
-        add_stick_penalty(w, inv_dt, p.friction_scale * friction_factor(d.drive, t), p.speed,
-                          d.mesh, p)
-        ratios = lam
-    R, F = reference.residual(u, th, old, inv_dt, t, d.mesh, p, d.drive, ld, ratios)
-    J = reference.jacobian(u, th, old, inv_dt, t, d.mesh, p, d.drive, ratios).toarray()
-    vrel = reference.slip_velocity(u, th, (u - old.u) * inv_dt, (th - old.theta) * inv_dt, t,
-                                   d.mesh, p, d.drive)
-    k = reference.friction(vrel, t, d.mesh, p, d.drive, ratios)[1]
-    return (w.R, fnode, blocks_to_dense(w.Lb, w.Db, w.Ub, w.L2)), (R, F, J), k
+CASE = "layout, law, step, gyro, inertia, loads, model"
 
 
-@pytest.mark.parametrize("law_name", list(LAWS))
-@pytest.mark.parametrize("inv_dt", [0.0, 3e3])
-@pytest.mark.parametrize("inertia, loads, gyro", [(True, True, UPWIND), (True, False, UPWIND),
-                                                  (False, True, UPWIND),
-                                                  (True, False, CENTRAL)])
-def test_residual_and_jacobian_match_the_reference(law_name, inv_dt, inertia, loads, gyro):
-    """assemble (primal form; exact laws with their stick penalty) is the reference's
-    residual and sparse Jacobian, with either gyroscopic form: the same sums in another
-    order, so they agree to round-off, ~1e-16 of the largest term of a row (1e-12 leaves
-    room for the cancellation of terms up to 1e4 times the row's result)."""
-    (Rk, Fk, Jk), (R, F, J), k = _kernel_and_reference(LAWS[law_name], inertia, inv_dt, loads,
-                                                       gyro=gyro)
-    np.testing.assert_allclose(Rk, R, rtol=0, atol=1e-12 * np.abs(R).max())
-    np.testing.assert_allclose(Fk, F, rtol=0, atol=1e-13 * np.abs(F).max())
-    scale = np.abs(J).max(axis=1, keepdims=True)  # rows in units of their largest entry
-    np.testing.assert_allclose(Jk / scale, J / scale, rtol=0, atol=1e-12)
-    # the friction's slopes are exercised: contact nodes away from saturation (for the
-    # exact law, stuck and sliding ones side by side)
-    assert np.count_nonzero(k > 0.1 * k.max()) >= 5
-    assert law_name != "exact" or np.count_nonzero(k == 0.0) >= 3
+@pytest.mark.parametrize(CASE, _params("straight", STRAIGHT_CASES)
+                         + _params("loop", LOOP_CASES))
+def test_kernel_residual_is_the_references(layout, law, step, gyro, inertia, loads, model):
+    """assemble's residual (the rows', and a loop's global rows) and nodal friction forces
+    are the reference's, to TOL of each row's terms."""
+    case = kernel_case(layout, law, step, 7, gyro, inertia, loads, model)
+    w, got, F = kernel_residual(case)
+    want, F_ref = reference_residual(case)
+    T = row_terms(case, dense_jacobian(w, layout == "loop"), want)
+    assert np.max(np.abs(got - want) / T) < TOL
+    np.testing.assert_allclose(F, F_ref, rtol=0, atol=1e-13 * np.abs(F_ref).max())
+    # friction and the global rows are exercised: contact nodes away from saturation (for
+    # the exact law, stuck and sliding ones side by side)
+    sg = w.sg[case.mesh.cn]
+    assert np.count_nonzero(sg > 0.1 * sg.max()) >= 5
+    assert law != "exact" or np.count_nonzero(sg == 0.0) >= 3
+    assert np.all(w.Rg != 0.0)
+
+
+@pytest.mark.parametrize(CASE, _params("straight", STRAIGHT_CASES))
+def test_kernel_jacobian_is_the_references_sparse_jacobian(layout, law, step, gyro, inertia,
+                                                           loads, model):
+    """On the straight belt the reference has a sparse Jacobian of its own (its
+    linearisation, which the stability analysis reads): assemble's blocks (exact laws with
+    their stick penalty) are it, rows in units of their largest entry, to 1e-12. (The
+    loop's reference is its residual only: the next test checks the loop's blocks.)"""
+    case = kernel_case(layout, law, step, 7, gyro, inertia, loads, model)
+    w, _, _ = kernel_residual(case)
+    p, ratios = case.p, None
+    if p.law >= EXACT:
+        add_stick_penalty(w, case.inv_dt, p.friction_scale * friction_factor(case.drive, case.t),
+                          p.speed, case.mesh, p)
+        ratios = case.lam
+    J = reference.jacobian(case.u, case.th, case.old, case.inv_dt, case.t, case.mesh, p,
+                           case.drive, ratios).toarray()
+    scale = np.abs(J).max(axis=1, keepdims=True)
+    np.testing.assert_allclose(dense_jacobian(w) / scale, J / scale, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize(CASE, _params("straight", [
+    (law, step, "upwind", True, True, "beam") for law in ("linear", "tanh", "sqrt", "ramp")
+    for step in (False, True)]) + _params("loop", [
+        (law, step, "upwind", True, False, model) for law in ("tanh", "sqrt")
+        for step in (False, True) for model in ("beam", "string")]))
+def test_kernel_jacobian_is_the_derivative_of_the_references_residual(layout, law, step, gyro,
+                                                                      inertia, loads, model):
+    """assemble's blocks (and a loop's global columns, rows and block) against central
+    differences of the reference's residual (helpers.reference_derivative: truncation and
+    round-off ~1e-7 of a row's terms), at states whose slip velocities lie on the steep
+    part of the law."""
+    case = kernel_case(layout, law, step, 3, gyro, inertia, loads, model)
+    w, _, _ = kernel_residual(case)
+    J = dense_jacobian(w, layout == "loop")
+    J_ref = reference_derivative(case)
+    T = np.max(np.abs(J_ref) * case.m, axis=1)
+    assert np.max(np.abs(J - J_ref) * case.m / T[:, None]) < 1e-6
+    # on a loop, both the pressure's and the speeds' slopes are there
+    assert np.all(np.abs(w.Gc).max(axis=(0, 1), initial=0.0) > 0)
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_the_comparison_detects_a_coefficient_changed_by_1e_7(layout):
+    """The residual test's measure sees a tension stiffness changed by 1e-7 (on a loop b1,
+    from which its B = b1 - rho c^2 follows the speed c) at 1e3 times its tolerance."""
+    case = kernel_case(layout, "tanh", True, 5)
+    want, _ = reference_residual(case)
+    name = "b1" if layout == "loop" else "B"
+    stiffer = case._replace(p=case.p._replace(**{name: getattr(case.p, name) * (1 + 1e-7)}))
+    _, got, _ = kernel_residual(stiffer)
+    T = row_terms(case, reference_derivative(case), want)
+    assert np.max(np.abs(got - want) / T) > 1e3 * TOL
 
 
 def test_hermite_loads_interpolate_cubics_exactly():
@@ -146,7 +195,7 @@ def test_hermite_loads_interpolate_cubics_exactly():
 def test_dual_residual_equals_primal_when_multiplier_consistent(law_name):
     """With lam = g(v_rel/v_reg) the condensed (dual) residual is the primal one."""
     d, grid, p = _setup([f"numerics.friction_law={law_name}"])
-    u, th, old = _random_state(grid, 2, amp=1e-6)
+    u, th, old = straight_state(len(grid.x), 2, 1e-6)
     lam = np.zeros_like(u)
     wp, _ = _assemble(d, u, th, lam, old, 1e4, 1.0, p)
     lam_d = np.clip(lam, -0.999, 0.999)  # keep inside the dual's domain
@@ -155,38 +204,6 @@ def test_dual_residual_equals_primal_when_multiplier_consistent(law_name):
     rows = keep[1:-1]
     np.testing.assert_allclose(wd.R[rows], wp.R[rows], rtol=1e-7,
                                atol=1e-7 * np.abs(wp.R).max())
-
-
-@pytest.mark.parametrize("law_name", ["linear", "tanh", "sqrt", "ramp"])
-@pytest.mark.parametrize("inv_dt", [0.0, 3e3])
-def test_reference_jacobian_is_the_derivative_of_its_residual(law_name, inv_dt):
-    """The reference's sparse Jacobian against central differences of its residual (which
-    the kernels match, test above), at a state whose slip velocities lie on the steep
-    part of the law (v_reg 5 m/s against ~5 m/s)."""
-    d, grid, p = _setup()
-    p = p._replace(law=LAWS[law_name], regularisation=5.0)
-    u, th, old = _random_state(grid, 3, amp=1e-4)
-    loads = _random_loads(len(u), 3)
-    J = reference.jacobian(u, th, old, inv_dt, 0.005, d.mesh, p, d.drive).toarray()
-    n = grid.n_elements - 1
-    Jfd = np.zeros_like(J)
-    y = np.column_stack([u[1:-1], th[1:-1]]).ravel()
-    for k in range(2 * n):
-        # step 1e-9 against values ~1e-4: the truncation, O(step^2) of the law's third
-        # derivative over the slip velocity's scale, and the round-off of R / step are
-        # both below 1e-7 of a row's largest entry
-        step = 1e-9
-        res = []
-        for sgn in (1, -1):
-            yy = y.copy()
-            yy[k] += sgn * step
-            uu, tt = u.copy(), th.copy()
-            uu[1:-1], tt[1:-1] = yy[0::2], yy[1::2]
-            res.append(reference.residual(uu, tt, old, inv_dt, 0.005, d.mesh, p, d.drive,
-                                          loads)[0].ravel())
-        Jfd[:, k] = (res[0] - res[1]) / (2 * step)
-    scale = np.abs(J).max(axis=1, keepdims=True)
-    np.testing.assert_allclose(J / scale, Jfd / scale, rtol=0, atol=1e-6)
 
 
 @pytest.mark.parametrize("gyro", [UPWIND, CENTRAL])
@@ -220,7 +237,7 @@ def test_power_terms_match_the_reference(gyro):
     state = State(*(1e-3 * rng.standard_normal(n_nodes) for _ in range(6)))
     for a in state[:6]:
         a[[0, -1]] = 0.0
-    loads = _random_loads(n_nodes, 12)
+    loads = random_loads(n_nodes, 12)
     out = np.zeros(len(POWER_TERMS))
     power_terms(state, 0.005, d.mesh, p, d.drive, loads, out)
     want = reference.power_terms(state, 0.005, d.mesh, p, d.drive, loads)
@@ -243,7 +260,7 @@ def test_block_factor_matches_dense_on_a_tridiagonal_system():
     x = np.zeros((n, 2))
     assert block_factor(Lb, Db, Ub, w)
     block_substitute(w, r, x)
-    ref = np.linalg.solve(blocks_to_dense(Lb, Db, Ub), r.ravel())
+    ref = np.linalg.solve(dense_jacobian(w), r.ravel())  # w.L2 = 0
     np.testing.assert_allclose(x.ravel(), ref, rtol=1e-10, atol=1e-12)
 
 
@@ -259,7 +276,7 @@ def test_banded_block_factor_matches_dense():
     x = np.zeros((n, 2))
     assert block_factor(w.Lb, w.Db, w.Ub, w)
     block_substitute(w, r, x)
-    ref = np.linalg.solve(blocks_to_dense(w.Lb, w.Db, w.Ub, w.L2), r.ravel())
+    ref = np.linalg.solve(dense_jacobian(w), r.ravel())
     np.testing.assert_allclose(x.ravel(), ref, rtol=1e-10, atol=1e-12)
 
 

@@ -13,6 +13,7 @@ from beltsim.physics.model import assemble
 from beltsim.problem.drive import Drive, Profile
 from beltsim.solvers.newton import Workspace, factorise, linear_solve
 from beltsim.solvers.ssn import saddle_solve, saddle_system
+from helpers import dense_jacobian
 
 pytestmark = pytest.mark.unit
 
@@ -46,20 +47,6 @@ DRIVE = Drive(Profile.constant(12.1), Profile.constant(1.0), Profile.constant(40
 INV_DT = 50.0
 
 
-def _dense(Lb, L2, Db, Ub, Gc, Gr, Gd):
-    """The whole Jacobian of a loop from its wrapped bands and global blocks."""
-    n, b, ng = Db.shape[0], Db.shape[1], Gd.shape[0]
-    J = np.zeros((b * n + ng, b * n + ng))
-    for i in range(n):
-        for band, o in ((L2, -2), (Lb, -1), (Db, 0), (Ub, 1)):
-            q = (i + o) % n
-            J[b * i:b * i + b, b * q:b * q + b] += band[i]
-        J[b * i:b * i + b, b * n:] = Gc[i]
-        J[b * n:, b * i:b * i + b] = Gr[:, i, :]
-    J[b * n:, b * n:] = Gd
-    return J
-
-
 def _fd(fun, x0, n_fields):
     """Central differences of fun at x0 (steps relative to each unknown's size)."""
     J = np.zeros((len(fun(x0)), len(x0)))
@@ -87,7 +74,7 @@ def test_loop_jacobian_matches_finite_differences_and_the_bordered_solve_a_dense
     x0 = np.concatenate([np.column_stack([u, th]).ravel(), g])
     Jfd = _fd(res, x0, 2 * N)
     res(x0)
-    J = _dense(w.Lb, w.L2, w.Db, w.Ub, w.Gc, w.Gr, w.Gd)
+    J = dense_jacobian(w, closed=True)
     # central differences with relative steps 1e-7: truncation and round-off ~1e-7 of a
     # row's largest entry
     scale = np.abs(Jfd).max(axis=1, keepdims=True)
@@ -127,7 +114,7 @@ def test_loop_semismooth_system_matches_finite_differences_and_its_bordered_solv
     assert 0 < active[mesh.cn].sum() < len(mesh.cn)  # both stuck and sliding nodes
     Jfd = _fd(lambda x: res(x, active), x0, 3 * N)
     res(x0)
-    J = _dense(s.Lb, s.L2, s.Db, s.Ub, s.Gc, s.Gr, s.Gd)
+    J = dense_jacobian(s, closed=True)
     scale = np.abs(Jfd).max(axis=1, keepdims=True)
     assert np.max(np.abs(J - Jfd) / scale) < 1e-6
     rhs = np.concatenate([s.R.ravel(), s.Rg])

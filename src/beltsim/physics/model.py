@@ -554,18 +554,3 @@ def stored_energy(state, mesh: Mesh, p: ModelParams) -> float:
                      + p.A * np.sum(np.diff(state.theta) ** 2 / he)
                      + p.shear * np.sum(hb * state.theta**2))
     return float(kinetic + elastic)
-
-
-def blocks_to_dense(Lb, Db, Ub, L2=None):
-    """Dense matrix of a block-banded Jacobian (tests): L2 the second lower band."""
-    n = Db.shape[0]
-    J = np.zeros((2 * n, 2 * n))
-    for i in range(n):
-        J[2 * i:2 * i + 2, 2 * i:2 * i + 2] = Db[i]
-        if i > 1 and L2 is not None:
-            J[2 * i:2 * i + 2, 2 * i - 4:2 * i - 2] = L2[i]
-        if i > 0:
-            J[2 * i:2 * i + 2, 2 * i - 2:2 * i] = Lb[i]
-        if i < n - 1:
-            J[2 * i:2 * i + 2, 2 * i + 2:2 * i + 4] = Ub[i]
-    return J
