@@ -20,14 +20,14 @@ from .registry import register
 
 
 @njit(cache=True)
-def restore(state, old):
-    """Put back the step's start: the fields, their rates, the friction unknowns and a
-    loop's globals."""
-    for j in range(state.u.shape[0]):
-        state.u[j], state.theta[j] = old.u[j], old.theta[j]
-        state.ud[j], state.td[j], state.lam[j] = old.ud[j], old.td[j], old.lam[j]
-    for k in range(state.g.shape[0]):
-        state.g[k], state.gd[k] = old.g[k], old.gd[k]
+def copy_step(dst, src):
+    """``dst`` = ``src`` in the fields, their rates, the friction unknowns and a loop's
+    globals: a step's start saved, or put back."""
+    for j in range(dst.u.shape[0]):
+        dst.u[j], dst.theta[j] = src.u[j], src.theta[j]
+        dst.ud[j], dst.td[j], dst.lam[j] = src.ud[j], src.td[j], src.lam[j]
+    for k in range(dst.g.shape[0]):
+        dst.g[k], dst.gd[k] = src.g[k], src.gd[k]
 
 
 @njit(cache=True)
@@ -38,8 +38,8 @@ def advance_backward_euler(state, old, t, t_stop, dt, dt_nominal, max_steps, mes
     Updates ``state`` in place; ``old`` is workspace for the previous step. Returns
     (status, t, dt, steps).
     """
-    u, th, lam, ud, td = state.u, state.theta, state.lam, state.ud, state.td
-    uo, tho, udo, tdo, lamo = old.u, old.theta, old.ud, old.td, old.lam
+    u, th, ud, td = state.u, state.theta, state.ud, state.td
+    uo, tho, udo, tdo = old.u, old.theta, old.ud, old.td
     g, gd, go, gdo = state.g, state.gd, old.g, old.gd
     N = u.shape[0] - 1
     off = mesh.off
@@ -47,14 +47,7 @@ def advance_backward_euler(state, old, t, t_stop, dt, dt_nominal, max_steps, mes
     good = 0
     dt_min = dt_nominal * 1e-7
     while t < t_stop and steps < max_steps:
-        for j in range(N + 1):
-            uo[j] = u[j]
-            tho[j] = th[j]
-            udo[j] = ud[j]
-            tdo[j] = td[j]
-            lamo[j] = lam[j]
-        for k in range(g.shape[0]):
-            go[k], gdo[k] = g[k], gd[k]
+        copy_step(old, state)
         h = dt
         inv = 1.0 / h
         # predictor: constant local velocity over the step
@@ -77,7 +70,7 @@ def advance_backward_euler(state, old, t, t_stop, dt, dt_nominal, max_steps, mes
                 if not np.isfinite(g[k]):
                     finite = False
             if not finite:
-                restore(state, old)
+                copy_step(state, old)
                 return NONFINITE, t, dt, steps
             t += h
             steps += 1
@@ -87,7 +80,7 @@ def advance_backward_euler(state, old, t, t_stop, dt, dt_nominal, max_steps, mes
                 good = 0
         else:
             w.stats[0].failed_steps += 1
-            restore(state, old)
+            copy_step(state, old)
             dt *= 0.25
             good = 0
             if dt < dt_min:
