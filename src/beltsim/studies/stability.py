@@ -100,11 +100,13 @@ class Case:
         base is not installed."""
         return shipped_scene(self.base) if isinstance(self.base, str) else self.base
 
-    def scene(self, extra=()) -> Scene:
-        """The case's scene with ``extra`` (key, value) overrides; raises SceneError when
-        they break a rule, MissingInputError when a shipped base is not installed."""
+    def scene(self, extra=(), base=None) -> Scene:
+        """The case's scene with ``extra`` (key, value) overrides, from ``base`` (default
+        :meth:`base_scene`); raises SceneError when they break a rule, MissingInputError
+        when a shipped base is not installed."""
         span = [("numerics.t_end", self.span)] if self.span else []
-        return self.base_scene().with_overrides([*self.overrides, *span, *extra])
+        base = self.base_scene() if base is None else base
+        return base.with_overrides([*self.overrides, *span, *extra])
 
 
 #: The closed drive's cases, each derived from drive_flat (R = 80 / 160 mm, 12 m/s, 50 N m
@@ -185,13 +187,14 @@ def stability_cell(case: Case, scheme: str, extra=(), bounds=None, discrete=Fals
     A shipped base scene that is not installed raises MissingInputError: a missing input
     fails the study, it is never a refused cell.
     """
-    closed = is_drive_scene(case.base_scene())
+    base = case.base_scene()
+    closed = is_drive_scene(base)
     keys = readout_class(closed).error_keys
     cell = {"scheme": scheme, "status": "", "reason": "", "reason_key": "",
             "dt": float("nan"), "steps": 0, "wall_time": float("nan"),
             **{f"error_{k}": float("nan") for k in keys}}
     try:
-        scene = case.scene(extra)
+        scene = case.scene(extra, base)
     except SceneError as exc:
         cell.update(status=CellStatus.REFUSED, reason=str(exc), reason_key=exc.key or "")
         return cell
