@@ -1,5 +1,6 @@
 """The package's structure: no import circles between its modules (at module level or
-inside functions), and no private name imported from another package."""
+inside functions), no private name imported from another package, and no module longer
+than MAX_LINES."""
 
 import ast
 
@@ -74,3 +75,14 @@ def test_no_private_names_across_packages():
              if name.startswith("_") and not name.endswith("__")  # __version__ is public
              and target.split(".")[:2] != module.split(".")[:2]}
     assert found <= KNOWN_PRIVATE, found - KNOWN_PRIVATE
+
+
+#: The longest a module may be, in lines: a longer one is split along a seam (as
+#: physics.model was, into the kernels and physics.discrete, the data they read).
+MAX_LINES = 600
+
+
+def test_no_module_is_longer_than_max_lines():
+    long = {module: n for module, (path, _) in _modules().items()
+            if (n := len(path.read_text(encoding="utf-8").splitlines())) > MAX_LINES}
+    assert not long, long
