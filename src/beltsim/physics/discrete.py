@@ -1,8 +1,9 @@
-"""The discrete model's data, as its kernels (:mod:`beltsim.physics.model`) read them:
-the coefficients (:class:`ModelParams`), a layout on its grid (:class:`Mesh`; the open
-layout's from :func:`mesh_of`, a loop's from :mod:`beltsim.physics.layout`), the state
-(:class:`State`) and the distributed loads (:class:`Loads`, tabulated in time, with the
-kernels that interpolate them).
+"""The discrete model's data, as its kernels read them.
+
+The kernels (:mod:`beltsim.physics.model`) read the coefficients (:class:`ModelParams`), a
+layout on its grid (:class:`Mesh`; the open layout's from :func:`mesh_of`, a loop's from
+:mod:`beltsim.physics.layout`), the state (:class:`State`) and the distributed loads
+(:class:`Loads`, tabulated in time, with the kernels that interpolate them).
 """
 
 from __future__ import annotations

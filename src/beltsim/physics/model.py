@@ -479,7 +479,8 @@ def update_multipliers(lam, dx, dg, inv_dt, c, mesh, p, w):
 def traction(fnode, wf):
     """Traction f (N/m) at each friction node: F_j / wf_j, 0 off contact.
 
-    wf: the friction weights of :class:`Mesh` (contact_stencil). Works on stacks of
+    wf: the friction weights of :class:`~beltsim.physics.discrete.Mesh`
+    (:func:`~beltsim.physics.discrete.contact_stencil`). Works on stacks of
     states (last axis: nodes).
     """
     f = np.zeros_like(fnode)
