@@ -37,8 +37,9 @@ import numpy as np
 
 from beltsim.errors import FailureKind, NumericalError
 from beltsim.physics import reference
+from beltsim.physics.discrete import State
 from beltsim.physics.friction import SQRT, TANH, law_inverse_numpy, law_numpy
-from beltsim.physics.model import LAM_MAX, POWER_TERMS, State
+from beltsim.physics.model import LAM_MAX, POWER_TERMS
 from beltsim.simulation.controller import Simulation
 from beltsim.solvers.base import Scheme
 from beltsim.solvers.implicit import (

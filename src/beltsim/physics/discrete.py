@@ -229,8 +229,3 @@ def mesh_of(grid) -> Mesh:
                 cn=np.arange(c0, grid.j2 + 1, dtype=np.int64), seg=seg,
                 seg_mu=np.zeros(1), seg_radius=np.zeros(1),
                 seg_speed=-np.ones(1, dtype=np.int64))
-
-
-def n_rows(mesh: Mesh) -> int:
-    """The rows (nodes with unknowns) of a layout: N - 1 open, N closed."""
-    return len(mesh.hb) - 2 * mesh.off

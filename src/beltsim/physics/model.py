@@ -42,10 +42,6 @@ from numba import njit
 
 from ..problem.drive import friction_factor, mismatch, value
 from .discrete import CENTRAL, Mesh, ModelParams, hermite_weights, load_at
-
-# benchmarks/port.py still imports State from here (benchmarks/ is being edited on main):
-# once its import reads physics.discrete, drop this line
-from .discrete import State as State
 from .friction import AUGMENTATION, EXACT, law, law_inverse
 
 # |lam| bound in the primal-dual iteration: the friction of a fully sliding node is

@@ -63,7 +63,7 @@ class Simulation:
     snapshot_interval : float, optional
         Store the state every so many seconds of simulated time (default the scene's
         ``numerics.snapshot_interval``; none without it).
-    loads : beltsim.physics.model.Loads, optional
+    loads : beltsim.physics.discrete.Loads, optional
         Distributed loads on this grid.
 
     Raises
@@ -80,7 +80,7 @@ class Simulation:
     def __init__(self, scene: Scene, grid: Grid | None = None,
                  snapshot_interval: float | None = None, loads=None):
         self.disc = solvers.discretise(scene, grid)
-        if loads is not None:  # distributed loads (physics.model.Loads) on this grid
+        if loads is not None:  # distributed loads (physics.discrete.Loads) on this grid
             self.disc.loads = loads
         self.readout = readout_of(self.disc)
         self.scheme = solvers.get(self.disc.numerics.integrator)(self.disc)
