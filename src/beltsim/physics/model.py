@@ -41,7 +41,19 @@ import numpy as np
 from numba import njit
 
 from ..problem.drive import friction_factor, mismatch, value
-from .discrete import CENTRAL, Mesh, ModelParams, hermite_weights, load_at
+
+# Loads and State are not used here: numba's cache indexes written before they moved to
+# physics.discrete name them here, and unpickling such an index must find them, or every
+# cached kernel fails to load
+from .discrete import (  # noqa: F401
+    CENTRAL,
+    Loads,
+    Mesh,
+    ModelParams,
+    State,
+    hermite_weights,
+    load_at,
+)
 from .friction import AUGMENTATION, EXACT, law, law_inverse
 
 # |lam| bound in the primal-dual iteration: the friction of a fully sliding node is
