@@ -11,6 +11,7 @@ import beltsim
 from beltsim.api import shipped_scene
 from beltsim.beltdrive import DriveScene, GrossSlipError, capacity, solve_string
 from beltsim.physics.layout import LoopGrid
+from beltsim.simulation.controller import Simulation
 from beltsim.simulation.result import RunStatus
 from beltsim.solvers.settings import LOOP_ELEMENTS as DEFAULT_ELEMENTS
 from beltsim.solvers.settings import LOOP_TIME_TOLS
@@ -412,6 +413,55 @@ def time_path(page: Page, quick: bool) -> None:
         "tolerance.")
 
 
+#: the free-step path study's sample interval (s): few enough landings that the steps are
+#: the error control's own
+SAMPLE_INTERVAL = 0.02
+
+
+def _sampled_path(scene, t_end):
+    """(values at every SAMPLE_INTERVAL up to t_end (samples, PATH_KEYS), steps, wall)."""
+    sim = Simulation(scene)
+    sim.warm_up()
+    start = time.perf_counter()
+    rows = []
+    for t in np.arange(SAMPLE_INTERVAL, t_end + 1e-12, SAMPLE_INTERVAL):
+        sim.advance(t)
+        summary = sim.solution().summary()
+        rows.append([summary[k] for k in PATH_KEYS])
+    return np.array(rows), sim.steps, time.perf_counter() - start
+
+
+def free_path(page: Page, quick: bool) -> None:
+    grid = [("numerics.elements", QUICK_ELEMENTS)] if quick else []
+    t_end = 0.3 if quick else 0.6
+    ref_tol = TIME_REFERENCE[quick]
+    page.para(
+        "The same start-up with the steps the error control chooses: the study above lands "
+        f"a step on every check ({CHECK_INTERVAL * 1e3:g} ms), which caps them. Here the "
+        f"run is sampled every {SAMPLE_INTERVAL:g} s up to t = {t_end:g} s, against a run "
+        f"at {ref_tol:g}; path error as above (largest difference over the samples, "
+        "relative to the steady value). This is what sets the default tolerance: the "
+        f"largest that keeps the speeds' and the tensions' paths within {PATH_TOL:g}.")
+    runs = {tol: _sampled_path(shipped_scene(SCENE, [*grid, ("numerics.time_tol", tol),
+                                                     ("numerics.t_end", t_end),
+                                                     ("numerics.steady_tol", 1e-30)]), t_end)
+            for tol in (*TIME_TOLS[quick], ref_tol)}
+    ref = runs[ref_tol][0]
+    body = []
+    for tol in TIME_TOLS[quick]:
+        values, steps, wall = runs[tol]
+        errs = np.max(np.abs(values - ref), axis=0) / np.abs(ref[-1])
+        if tol == DEFAULT_TIME_TOL and np.max(errs) > PATH_TOL:
+            page.fail(f"the default time_tol's free-step path error {np.max(errs):.2e} "
+                      f"exceeds {PATH_TOL:g}")
+        body.append([f"{tol:g}", str(steps), f"{wall:.3g}", *(f"{e:.2e}" for e in errs)])
+    _, steps, wall = runs[ref_tol]
+    body.append([f"{ref_tol:g} (reference)", str(steps), f"{wall:.3g}",
+                 *("" for _ in PATH_KEYS)])
+    page.table(["time_tol", "steps", "wall [s]",
+                *(f"path error, {k.replace('_', ' ')}" for k in PATH_KEYS)], body)
+
+
 def build(page: Page, quick: bool) -> None:
     page.para(
         f"The shipped `{SCENE}` scene (a flat belt on pulleys of radius R = 80 / 160 mm, "
@@ -429,6 +479,7 @@ def build(page: Page, quick: bool) -> None:
     startup(page, quick)
     page.heading("The path in time")
     time_path(page, quick)
+    free_path(page, quick)
     page.heading("The gross-slip threshold")
     threshold(page, quick)
     page.heading("The power balance at steady state")
