@@ -440,8 +440,10 @@ def free_path(page: Page, quick: bool) -> None:
         f"a step on every check ({CHECK_INTERVAL * 1e3:g} ms), which caps them. Here the "
         f"run is sampled every {SAMPLE_INTERVAL:g} s up to t = {t_end:g} s, against a run "
         f"at {ref_tol:g}; path error as above (largest difference over the samples, "
-        "relative to the steady value). This is what sets the default tolerance: the "
-        f"largest that keeps the speeds' and the tensions' paths within {PATH_TOL:g}.")
+        "relative to the steady value). This is the study that sets the default "
+        f"tolerance, {DEFAULT_TIME_TOL:g}: it must keep the speeds' and the tensions' paths "
+        f"within {PATH_TOL:g} (the page fails otherwise), with room left for drives that "
+        "ring longer than this one.")
     runs = {tol: _sampled_path(shipped_scene(SCENE, [*grid, ("numerics.time_tol", tol),
                                                      ("numerics.t_end", t_end),
                                                      ("numerics.steady_tol", 1e-30)]), t_end)
