@@ -17,6 +17,7 @@ from beltsim.physics.model import JACOBIAN, assemble
 from beltsim.problem.drive import Drive, Profile
 from beltsim.problem.scene import Scene
 from beltsim.solvers import Discretisation, LoopDiscretisation
+from beltsim.solvers.linearise import jacobian_matrix
 from beltsim.solvers.newton import Workspace
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -253,20 +254,9 @@ def reference_derivative(case: KernelCase, step=1e-7):
 
 
 def dense_jacobian(w, closed=False):
-    """The whole Jacobian of a workspace's bands (2x2 blocks, or the exact laws' 3x3) and,
-    on a loop, its global columns Gc, rows Gr and block Gd. An open layout's bands stop at
-    its ends; a loop's wrap round (row 0's Lb couples to the last node)."""
-    n, b, ng = w.Db.shape[0], w.Db.shape[1], w.Gd.shape[0]
-    J = np.zeros((b * n + ng, b * n + ng))
-    for i in range(n):
-        for band, o in ((w.L2, -2), (w.Lb, -1), (w.Db, 0), (w.Ub, 1)):
-            q = (i + o) % n if closed else i + o
-            if 0 <= q < n:
-                J[b * i:b * i + b, b * q:b * q + b] += band[i]
-        J[b * i:b * i + b, b * n:] = w.Gc[i]
-        J[b * n:, b * i:b * i + b] = w.Gr[:, i, :]
-    J[b * n:, b * n:] = w.Gd
-    return J
+    """The whole Jacobian of a workspace (or the exact laws' saddle blocks) as a dense
+    array: :func:`beltsim.solvers.linearise.jacobian_matrix`."""
+    return jacobian_matrix(w, closed).toarray()
 
 
 def row_terms(case: KernelCase, J, r):

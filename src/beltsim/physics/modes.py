@@ -149,14 +149,10 @@ def spectrum(disc, state) -> np.ndarray:
                                        overwrite_a=True, check_finite=False)
     # B's null space (a loop's massless globals and gauge) gives beta = 0, or round-off
     # of it: eigenvalues beyond INFINITE times the grid's highest frequency
-    finite = np.abs(beta) * INFINITE * _highest(disc) > np.abs(alpha)
+    from ..solvers.linearise import highest_frequency
+
+    finite = np.abs(beta) * INFINITE * highest_frequency(disc) > np.abs(alpha)
     return alpha[finite] / beta[finite]
-
-
-def _highest(disc) -> float:
-    """The grid's highest axial frequency (rad/s), sqrt(b1 / rho) / h."""
-    P = disc.params
-    return math.sqrt(P.b1 / P.rho) / float(np.min(disc.mesh.he))
 
 
 def growth_rate(scene, dense_elements=None) -> Growth:

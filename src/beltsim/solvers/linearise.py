@@ -21,6 +21,8 @@ sliding nodes with the slope of their bound, as the straight belt's vectorised r
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -33,34 +35,44 @@ from .newton import Workspace
 ROUND_OFF = 1e-14
 
 
-def jacobian_matrix(w: Workspace, closed: bool) -> sp.csr_matrix:
-    """The Jacobian the kernel left in ``w`` as one sparse matrix over (u, theta, g):
-    its block bands (wrapping round a loop) and a loop's border."""
-    n, ng = w.Db.shape[0], w.Gd.shape[0] if closed else 0
+def jacobian_matrix(w, closed: bool) -> sp.csr_matrix:
+    """The Jacobian the kernel left in ``w`` (a Newton workspace's 2x2 blocks, or the exact
+    laws' 3x3 saddle blocks) as one sparse matrix over each node's unknowns, then the
+    globals: its block bands, which stop at an open layout's ends and wrap round a loop,
+    and a loop's border (global columns Gc, rows Gr, block Gd)."""
+    n, b, ng = w.Db.shape[0], w.Db.shape[1], w.Gd.shape[0]
     rows, cols, vals = [], [], []
     i = np.arange(n)
     for band, o in ((w.L2, -2), (w.Lb, -1), (w.Db, 0), (w.Ub, 1)):
         q = i + o
         keep = slice(None) if closed else (q >= 0) & (q < n)
         q = q % n
-        for a in range(2):
-            for b in range(2):
-                rows.append(2 * i[keep] + a)
-                cols.append(2 * q[keep] + b)
-                vals.append(band[keep, a, b])
+        for a in range(b):
+            for c in range(b):
+                rows.append(b * i[keep] + a)
+                cols.append(b * q[keep] + c)
+                vals.append(band[keep, a, c])
     if ng:
-        for a in range(2):
+        for a in range(b):
             for k in range(ng):
-                rows += [2 * i + a, np.full(n, 2 * n + k)]
-                cols += [np.full(n, 2 * n + k), 2 * i + a]
+                rows += [b * i + a, np.full(n, b * n + k)]
+                cols += [np.full(n, b * n + k), b * i + a]
                 vals += [w.Gc[:, a, k], w.Gr[k, :, a]]
         gk = np.arange(ng)
-        rows.append(np.repeat(2 * n + gk, ng))
-        cols.append(np.tile(2 * n + gk, ng))
+        rows.append(np.repeat(b * n + gk, ng))
+        cols.append(np.tile(b * n + gk, ng))
         vals.append(w.Gd.ravel())
-    size = 2 * n + ng
+    size = b * n + ng
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                          shape=(size, size))
+
+
+def highest_frequency(disc) -> float:
+    """The grid's highest axial frequency sqrt(b1 / rho) / h (rad/s; 1 / h when
+    quasistatic): the scale of the linearisation's step rates and of a pencil's
+    largest finite eigenvalues."""
+    P, h = disc.params, float(np.min(disc.mesh.he))
+    return math.sqrt(P.b1 / P.rho) / h if P.rho > 0 else 1.0 / h
 
 
 def linearisation(disc, state):
@@ -76,10 +88,8 @@ def linearisation(disc, state):
     w = Workspace.allocate(disc.grid.n_elements, is_exact(p.law), disc.closed,
                            disc.n_globals)
     fnode = np.zeros_like(state.u)
-    # s where s^2 rho h and b1 / h balance: the grid's highest axial frequency
-    h = float(np.min(disc.mesh.he))
-    stiff = P.b1 if disc.closed else p.B
-    sigma = np.sqrt(stiff / max(P.rho, 1e-300)) / h if P.rho > 0 else 1.0 / h
+    # s where s^2 rho h and b1 / h balance
+    sigma = highest_frequency(disc)
     J = []
     for s in (sigma, 2.0 * sigma, 3.0 * sigma):
         assemble(state.u.copy(), state.theta.copy(), state.lam.copy(), state.g.copy(), fnode,
