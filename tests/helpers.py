@@ -14,7 +14,7 @@ from beltsim.physics import reference
 from beltsim.physics.discrete import GYROSCOPIC_FORMS, Loads, Mesh, ModelParams, State
 from beltsim.physics.friction import ADHESION, EXACT, LINEAR, RAMP, SQRT, TANH, is_exact
 from beltsim.physics.model import JACOBIAN, assemble
-from beltsim.problem.drive import Drive, Profile
+from beltsim.problem.drive import Drive, Profile, Profiles
 from beltsim.problem.scene import Scene
 from beltsim.solvers import Discretisation, LoopDiscretisation
 from beltsim.solvers.linearise import jacobian_matrix
@@ -74,7 +74,29 @@ def assert_errors_near(result, measured: dict, factor: float = ERROR_FACTOR):
 # (reference.residual on the straight belt, reference.loop_residual on the loop).
 
 #: The layouts of the one model: the paper's open belt and the closed two-pulley drive.
-LAYOUTS = ("straight", "loop")
+LAYOUTS = ("straight", "loop", "serpentine")
+
+#: A four-pulley drive of inner pulleys (the beam takes it): drive_flat's belt on a
+#: motor, a mill, a fan and an idler, listed counterclockwise.
+SERPENTINE_PULLEYS = [
+    {"name": "motor", "centre": [0.0, 0.0], "radius": 0.08, "speed": 150.0},
+    {"name": "mill", "centre": [0.55, 0.05], "radius": 0.12, "inertia": 0.02,
+     "load_torque": 20.0},
+    {"name": "fan", "centre": [0.38, 0.36], "radius": 0.06, "inertia": 0.005,
+     "load_torque": 5.0},
+    {"name": "idler", "centre": [0.05, 0.3], "radius": 0.04, "inertia": 1e-4},
+]
+
+
+def serpentine_scene(pulleys=None, model="beam", **over) -> DriveScene:
+    """drive_flat's belt, contact and physics on a layout of ``pulleys`` (tables of
+    [[pulley]]; SERPENTINE_PULLEYS by default), with ``over`` (SECTION.KEY: value)."""
+    data = DriveScene.load(scene_path("drive_flat")).to_dict()
+    data["drive"] = {"installation_tension": data["drive"]["installation_tension"]}
+    data["pulley"] = [dict(p) for p in (pulleys or SERPENTINE_PULLEYS)]
+    data["physics"]["model"] = model
+    scene = DriveScene.from_dict(data)
+    return scene.with_overrides(over) if over else scene
 
 #: The straight belt's friction laws by name (the loop's scene takes tanh, sqrt and
 #: exact, and adhesion as a "stick" contact).
@@ -83,10 +105,11 @@ LAWS = {"linear": LINEAR, "tanh": TANH, "sqrt": SQRT, "ramp": RAMP, "exact": EXA
 
 #: a backward-Euler step's 1 / dt, or 0 (the steady problem), on each layout: the loop's
 #: dt = 2e-4 s is about a thousandth of its belt's transit time
-INV_DT = {"straight": 3e3, "loop": 1.0 / 2e-4}
+INV_DT = {"straight": 3e3, "loop": 1.0 / 2e-4, "serpentine": 1.0 / 2e-4}
 
 #: The loop's drive: rim speed, friction factor and load torque.
-LOOP_DRIVE = Drive(Profile.constant(12.1), Profile.constant(0.9), Profile.constant(40.0))
+LOOP_DRIVE = Drive(Profile.constant(12.1), Profile.constant(0.9),
+                   Profiles.constants((0.0, 40.0)))
 
 
 class KernelCase(NamedTuple):
@@ -134,8 +157,11 @@ def kernel_case(layout, law, step, seed, gyro="upwind", inertia=True, loads=Fals
     """``layout`` with friction ``law`` (a name), a step (``step``; else the steady
     problem), the gyroscopic form, inertia, random loads and the string or beam model,
     and a random state drawn from ``seed``; ``grid``: a loop's own grid."""
-    make = _straight_case if layout == "straight" else _loop_case
-    return make(law, INV_DT[layout] if step else 0.0, seed, gyro, inertia, loads, model, grid)
+    if layout == "straight":
+        return _straight_case(law, INV_DT[layout] if step else 0.0, seed, gyro, inertia,
+                              loads, model, grid)
+    return _loop_case(layout, law, INV_DT[layout] if step else 0.0, seed, gyro, inertia,
+                      loads, model, grid)
 
 
 def _straight_case(law, inv_dt, seed, gyro, inertia, loads, model, grid):
@@ -157,13 +183,15 @@ def _straight_case(law, inv_dt, seed, gyro, inertia, loads, model, grid):
                       old, inv_dt, np.full(2 * (n - 2), amp), d)
 
 
-def _loop_case(law, inv_dt, seed, gyro, inertia, loads, model, grid):
-    """drive_flat on 60 elements (about 60 nodes, 26 of them in contact); the regularised
+def _loop_case(layout, law, inv_dt, seed, gyro, inertia, loads, model, grid):
+    """drive_flat ("loop") or its belt on SERPENTINE_PULLEYS ("serpentine") on 60
+    elements (about 60 nodes, 26 of them in contact on drive_flat); the regularised
     laws at half the creep speed, so that the random slip velocities reach their saturated
     part. The state's sizes are a time step's: u a strain of half N0 / b1 over an element
     (the pressure stays positive), theta N0 / b1, the speeds within 1e-3 and 1e-2 of the
     creep theory's."""
-    scene = DriveScene.load(scene_path("drive_flat"))
+    scene = (DriveScene.load(scene_path("drive_flat")) if layout == "loop"
+             else serpentine_scene())
     if law == "adhesion":
         data = scene.to_dict()
         data["contact"] = {"friction": "stick"}
@@ -179,20 +207,23 @@ def _loop_case(law, inv_dt, seed, gyro, inertia, loads, model, grid):
     P, mesh = d.params, d.mesh
     N = len(mesh.hb)
     strain = P.N0 / P.b1
-    rim = P.omega1 * P.geometry.R1
+    rim = P.driver_rim_speed
     mu_, mt = 0.25 * strain * float(np.min(mesh.he)), strain
-    mg = np.array([rim, rim / P.geometry.R2])
+    ng = d.n_globals
+    mg = np.concatenate([[rim], rim / mesh.seg_radius[d.speed_global >= 0]])
     u, th = mu_ * rng.uniform(-1, 1, N), mt * rng.uniform(-1, 1, N)
-    g = np.array([rim / (1.0 + strain) * (1.0 + 1e-3 * rng.uniform(-1, 1)),
-                  mg[1] * (1.0 + 1e-2 * rng.uniform(-1, 1))])
+    g = np.concatenate([[rim / (1.0 + strain) * (1.0 + 1e-3 * rng.uniform(-1, 1))],
+                        mg[1:] * (1.0 + 1e-2 * rng.uniform(-1, 1, ng - 1))])
     lam = np.where(mesh.seg >= 0, 2.0 * rng.uniform(-1, 1, N), 0.0)
     step = INV_DT["loop"]
     old = State(u - mu_ * rng.uniform(-1, 1, N), th - mt * rng.uniform(-1, 1, N),
                 np.zeros(N), step * mu_ * rng.uniform(-1, 1, N),
                 step * mt * rng.uniform(-1, 1, N), np.zeros(N),
-                g * (1.0 - 1e-3 * rng.uniform(-1, 1, 2)), np.zeros(2))
+                g * (1.0 - 1e-3 * rng.uniform(-1, 1, ng)), np.zeros(ng))
     ld = random_loads(N, seed + 7) if loads else Loads.none(N)
-    return KernelCase("loop", mesh, d.model, LOOP_DRIVE, ld, 0.3, u, th, lam, g, old,
+    drive = LOOP_DRIVE if layout == "loop" else LOOP_DRIVE._replace(
+        load=Profiles.constants([0.0] + [10.0 * k for k in range(1, ng)]))
+    return KernelCase(layout, mesh, d.model, drive, ld, 0.3, u, th, lam, g, old,
                       inv_dt, np.concatenate([np.tile([mu_, mt], N), mg]), d)
 
 
@@ -216,7 +247,7 @@ def kernel_residual(case: KernelCase):
     """(w, r, F): physics.model.assemble's workspace with the Jacobian, its residual (the
     rows', then the globals') and the nodal friction forces."""
     N = len(case.mesh.he)
-    closed = case.layout == "loop"
+    closed = case.layout != "straight"
     w = Workspace.allocate(N, False, closed, len(case.g))
     F = np.zeros(len(case.u))
     assemble(case.u.copy(), case.th.copy(), case.lam.copy(), case.g.copy(), F, case.old,
@@ -227,7 +258,7 @@ def kernel_residual(case: KernelCase):
 def reference_residual(case: KernelCase):
     """(r, F): physics.reference's residual (the rows', then the globals') and nodal
     friction forces; an exact law's ratios are the case's lam."""
-    if case.layout == "loop":
+    if case.layout != "straight":
         R, Rg, F = reference.loop_residual(case.u, case.th, case.lam, case.g, case.old,
                                            case.inv_dt, case.t, case.mesh, case.p,
                                            case.drive, case.loads)

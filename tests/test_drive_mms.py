@@ -100,7 +100,7 @@ def manufactured_error(scene, elements):
     # inside (-1, 1): the law's inverse is singular on the bound
     state.lam[cn] = np.clip(np.tanh(v / V_REG), -1.0 + 1e-12, 1.0 - 1e-12)
     work = Workspace.allocate(N, False, True, 2)
-    assert newton(state, d.new_state(), 0.0, 0.0, mesh, d.model, Drive.constant(rim1, M2),
+    assert newton(state, d.new_state(), 0.0, 0.0, mesh, d.model, Drive.constant(rim1, (0.0, M2)),
                   loads, d.scales, NewtonSettings(1e-12, 40), work)
     return (np.max(np.abs(state.u - u)) / U, np.max(np.abs(state.theta - th)) / THETA,
             abs(state.g[0] - C_STAR) / C_STAR, abs(state.g[1] - W2_STAR) / W2_STAR)

@@ -13,7 +13,7 @@ from beltsim.beltdrive.scene import max_rim_speed
 from beltsim.physics import reference
 from beltsim.physics.discrete import Loads, State
 from beltsim.physics.friction import law_numpy
-from beltsim.problem.drive import mismatch, value
+from beltsim.problem.drive import mismatch, value, value_at
 from beltsim.problem.scene import Scene
 from beltsim.simulation.controller import Simulation
 from beltsim.simulation.result import RunStatus
@@ -327,7 +327,7 @@ def test_a_loops_gauge_and_momentum_hold():
     assert P.rho * L * s.gd[0] == pytest.approx(np.sum(s.fnode), rel=1e-9)
     load = sim.disc.drive.load
     driven = np.sum(s.fnode[m.seg == 1])
-    assert P.J2 * s.gd[1] == pytest.approx(-value(load, sim.t) - P.geometry.R2 * driven,
+    assert P.J2 * s.gd[1] == pytest.approx(-value_at(load, 1, sim.t) - P.geometry.R2 * driven,
                                            rel=1e-12)
 
 
@@ -448,7 +448,7 @@ def _loop_step_numpy(d, u, th, va, wa, db, ga, dgp, gauge, t, dt):
     kb = dt * (1 / (rho * hb) + hh * hh / (rot * hb))
     ub1 = u1 + hh * th1
     F, ratio = np.zeros(n), np.zeros(n)
-    load, rim1 = value(d.drive.load, t1), value(d.drive.speed, t1)
+    load, rim1 = value_at(d.drive.load, 1, t1), value(d.drive.speed, t1)
     R2, J2 = mesh.seg_radius[1], mesh.inertia[1]
 
     def sweep(s, rim):

@@ -105,14 +105,14 @@ CASE = "layout, law, step, gyro, inertia, loads, model"
 
 
 @pytest.mark.parametrize(CASE, _params("straight", STRAIGHT_CASES)
-                         + _params("loop", LOOP_CASES))
+                         + _params("loop", LOOP_CASES) + _params("serpentine", LOOP_CASES))
 def test_kernel_residual_is_the_references(layout, law, step, gyro, inertia, loads, model):
     """assemble's residual (the rows', and a loop's global rows) and nodal friction forces
     are the reference's, to TOL of each row's terms."""
     case = kernel_case(layout, law, step, 7, gyro, inertia, loads, model)
     w, got, F = kernel_residual(case)
     want, F_ref = reference_residual(case)
-    T = row_terms(case, dense_jacobian(w, layout == "loop"), want)
+    T = row_terms(case, dense_jacobian(w, layout != "straight"), want)
     assert np.max(np.abs(got - want) / T) < TOL
     np.testing.assert_allclose(F, F_ref, rtol=0, atol=1e-13 * np.abs(F_ref).max())
     # friction and the global rows are exercised: contact nodes away from saturation (for
@@ -145,9 +145,9 @@ def test_kernel_jacobian_is_the_references_sparse_jacobian(layout, law, step, gy
 
 @pytest.mark.parametrize(CASE, _params("straight", [
     (law, step, "upwind", True, True, "beam") for law in ("linear", "tanh", "sqrt", "ramp")
-    for step in (False, True)]) + _params("loop", [
-        (law, step, "upwind", True, False, model) for law in ("tanh", "sqrt")
-        for step in (False, True) for model in ("beam", "string")]))
+    for step in (False, True)]) + [p for layout in ("loop", "serpentine") for p in _params(
+        layout, [(law, step, "upwind", True, False, model) for law in ("tanh", "sqrt")
+                 for step in (False, True) for model in ("beam", "string")])])
 def test_kernel_jacobian_is_the_derivative_of_the_references_residual(layout, law, step, gyro,
                                                                       inertia, loads, model):
     """assemble's blocks (and a loop's global columns, rows and block) against central
@@ -156,7 +156,7 @@ def test_kernel_jacobian_is_the_derivative_of_the_references_residual(layout, la
     part of the law."""
     case = kernel_case(layout, law, step, 3, gyro, inertia, loads, model)
     w, _, _ = kernel_residual(case)
-    J = dense_jacobian(w, layout == "loop")
+    J = dense_jacobian(w, layout != "straight")
     J_ref = reference_derivative(case)
     T = np.max(np.abs(J_ref) * case.m, axis=1)
     assert np.max(np.abs(J - J_ref) * case.m / T[:, None]) < 1e-6
@@ -170,7 +170,7 @@ def test_the_comparison_detects_a_coefficient_changed_by_1e_7(layout):
     from which its B = b1 - rho c^2 follows the speed c) at 1e3 times its tolerance."""
     case = kernel_case(layout, "tanh", True, 5)
     want, _ = reference_residual(case)
-    name = "b1" if layout == "loop" else "B"
+    name = "B" if layout == "straight" else "b1"
     stiffer = case._replace(p=case.p._replace(**{name: getattr(case.p, name) * (1 + 1e-7)}))
     _, got, _ = kernel_residual(stiffer)
     T = row_terms(case, reference_derivative(case), want)

@@ -10,7 +10,7 @@ from beltsim.physics.discrete import Loads, State
 from beltsim.physics.friction import LAW_CODES
 from beltsim.physics.layout import LoopGrid, loop_mesh, loop_params
 from beltsim.physics.model import assemble
-from beltsim.problem.drive import Drive, Profile
+from beltsim.problem.drive import Drive, Profile, Profiles
 from beltsim.solvers.newton import Workspace, factorise, linear_solve
 from beltsim.solvers.ssn import saddle_solve, saddle_system
 from helpers import dense_jacobian
@@ -22,7 +22,7 @@ def _loop(law="tanh", elements=40, overrides=()):
     P = load_scene("drive_flat", list(overrides)).params
     g = P.geometry
     mesh = loop_mesh(LoopGrid.build(g.lengths, elements), [(0, g.R1, -1), (2, g.R2, 1)],
-                     0.0 if P.mu is None else P.mu, (0.0, P.J2))
+                     [0.0 if P.mu is None else P.mu] * 2, (0.0, P.J2))
     prm = loop_params(a=P.a, b1=P.b1, b2=P.b2, rho=P.rho, I=P.I, lever=P.lever,
                       damping=P.damping, N0=P.N0, law=LAW_CODES[law], dual=0,
                       regularisation=0.05)
@@ -43,7 +43,8 @@ def _random(P, mesh, seed=1):
     return u, th, lam, g, old
 
 
-DRIVE = Drive(Profile.constant(12.1), Profile.constant(1.0), Profile.constant(40.0))
+DRIVE = Drive(Profile.constant(12.1), Profile.constant(1.0),
+              Profiles.constants((0.0, 40.0)))
 INV_DT = 50.0
 
 

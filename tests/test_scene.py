@@ -197,7 +197,7 @@ def test_shipped_scenes_load_by_name_and_match_their_files():
     assert {"paper_slip", "paper_inertia", "paper_quasistatic"} <= set(names)
     from beltsim.beltdrive import DriveScene
     for name in names:
-        cls = DriveScene if name.startswith("drive_") else beltsim.Scene
+        cls = DriveScene if name.startswith(("drive_", "serpentine_")) else beltsim.Scene
         assert (beltsim.load_scene(name).to_dict()
                 == cls.load(scene_path(name)).to_dict())
     assert beltsim.paper_scene("slip").to_dict() == beltsim.load_scene("paper_slip").to_dict()

@@ -208,14 +208,13 @@ def solve(scene, model: str | None = None, overrides=()):
     """
     scene = load_scene(scene, overrides)
     if is_drive_scene(scene):
-        from .beltdrive.analytic import solve_string
-        from .beltdrive.beam import exact_state
+        from .beltdrive.exact import exact_state, string_state
 
         P = scene.params
         if model is None or model == P.model:
             return exact_state(P)  # as `beltsim analytic` and a run's comparison
         if model == "string":
-            return solve_string(P)
+            return string_state(P)
         raise UsageError(f'model: must be "string" or "{P.model}" for this drive, '
                          f"got {model!r}")
     from .problem.analytic import solve as solve_straight

@@ -8,7 +8,7 @@ from .errors import UsageError
 
 def format_summary(summary: dict, title: str = "") -> str:
     """A short human-readable table of a summary dict (a drive's: its figures)."""
-    if "tight_tension" in summary:
+    if "tight_tension" in summary or "spans" in summary:
         from .beltdrive.io import format_drive
         return format_drive(summary, title)
     rows = [("model", summary["model"]), ("inertia", str(summary["inertia"]).lower())]

@@ -17,9 +17,13 @@ the one discrete model (:mod:`beltsim.physics.layout`, :mod:`beltsim.solvers`).
 """
 
 from .analytic import GrossSlipError, LiftOffError, StringSolution, capacity, solve_string
-from .beam import exact_state
+from .creep import SerpentineData, SerpentineSolution, Tensioner, solve_serpentine
+from .exact import exact_state, string_state
 from .geometry import Geometry
+from .pulleys import Pulley, PulleyLayout
 from .scene import DriveParams, DriveScene
 
 __all__ = ["DriveParams", "DriveScene", "Geometry", "GrossSlipError", "LiftOffError",
-           "StringSolution", "capacity", "exact_state", "solve_string"]
+           "Pulley", "PulleyLayout", "SerpentineData", "SerpentineSolution",
+           "StringSolution", "Tensioner", "capacity", "exact_state", "solve_serpentine",
+           "solve_string", "string_state"]

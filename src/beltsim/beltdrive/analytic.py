@@ -32,6 +32,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import NoSolutionError
+from .figures import layout_summary
 from .geometry import SEGMENTS
 from .params import DriveParams
 
@@ -76,6 +77,11 @@ class StringSolution:
         return self.c * (1.0 + self.T2 / self.P.b1) / self.P.geometry.R2
 
     @property
+    def speeds(self) -> tuple[float, float]:
+        """The driver's and the driven pulley's speeds (rad/s)."""
+        return self.omega1, self.omega2
+
+    @property
     def speed_ratio(self) -> float:
         """omega2 R2 / (omega1 R1) = (b1 + T2) / (b1 + T1)."""
         return (self.P.b1 + self.T2) / (self.P.b1 + self.T1)
@@ -111,7 +117,9 @@ class StringSolution:
             "slip_arc_driver": self.phi_s, "slip_arc_driven": self.phi_s,
             "driver_torque": self.driver_torque, "efficiency": self.efficiency,
             "slip_power": self.slip_power,
-        }
+        } | layout_summary(self.P.layout, ("driver", "driven"), self.P.rho, self.c,
+                           (self.T2, self.T1), self.speeds, (self.phi_s, self.phi_s),
+                           (self.driver_torque, self.M2))
 
     def tension(self, x) -> np.ndarray:
         """Axial force N (N) at loop coordinates x (the value downstream at a jump)."""
@@ -336,9 +344,9 @@ __all__ = ["SEGMENTS", "GrossSlipError", "LiftOffError", "StringSolution", "capa
 
 def creep_speed(P: DriveParams) -> float:
     """The slip velocities' scale omega1 R1 N0 / b1 (m/s), the creep of the pretension."""
-    return P.omega1 * P.geometry.R1 * P.N0 / P.b1
+    return P.driver_rim_speed * P.N0 / P.b1
 
 
 def transit_time(P: DriveParams) -> float:
     """Lambda / (omega1 R1): how long the belt takes once round the loop (s)."""
-    return P.geometry.loop_length / (P.omega1 * P.geometry.R1)
+    return P.layout.loop_length / P.driver_rim_speed

@@ -406,14 +406,3 @@ def slip_collapse(P: DriveParams, mus, omega1: float | None = None,
 __all__ = ["FLOOR_STEP", "MAX_DAMPED", "MAX_ITERATIONS", "STEP_TOL", "BeamSolution",
            "capacity", "slip_collapse", "solve_beam"]
 
-
-def exact_state(P: DriveParams):
-    """The exact steady state a drive's run is compared with: the beam's for the beam
-    model, the creep theory's for the string.
-
-    Raises
-    ------
-    NoSolutionError
-        The drive has no steady state (gross slip, lift-off).
-    """
-    return solve_beam(P) if P.model == "beam" else solve_string(P)

@@ -11,6 +11,7 @@ import numpy as np
 from ..errors import NoSolutionError
 from .analytic import LiftOffError
 from .beam_loop import _graded, _Loop, _Seg
+from .figures import layout_summary
 from .params import DriveParams
 
 
@@ -151,6 +152,11 @@ class BeamSolution:
         """The mean axial force N (N) over the slack span."""
         return self._span_mean(2 if self._loop.coulomb else 1)
 
+    @property
+    def speeds(self) -> tuple[float, float]:
+        """The driver's and the driven pulley's speeds (rad/s)."""
+        return self.omega1, self.omega2
+
     def summary(self) -> dict:
         """The drive's figures, under the run summary's names."""
         arcs = self.slip_arcs
@@ -161,7 +167,11 @@ class BeamSolution:
             "slip_arc_driven": arcs[1], "driver_torque": self.driver_torque,
             "efficiency": self.efficiency, "slip_power": self.slip_power,
         }
-        return {k: float(v) for k, v in out.items()}
+        out = {k: float(v) for k, v in out.items()}
+        return out | layout_summary(
+            self.P.layout, ("driver", "driven"), self.P.rho, self.c,
+            (out["slack_tension"], out["tight_tension"]), self.speeds, arcs,
+            (self.driver_torque, self.M2))
 
     # fields ------------------------------------------------------------------------
     def _field(self, x, name):

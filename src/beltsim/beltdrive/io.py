@@ -14,7 +14,8 @@ SNAPSHOTS = "snapshots.npz"
 
 
 def format_drive(summary: dict, title: str = "") -> str:
-    """A short table of a drive's figures."""
+    """A short table of a drive's figures: a two-pulley drive's by name, and on more
+    pulleys each span's tension and each pulley's speed, slip arc, torque and hub load."""
     units = {"tight_tension": "N", "slack_tension": "N", "belt_speed": "m/s",
              "driven_speed": "rad/s", "speed_ratio": "", "slip_arc_driver": "rad",
              "slip_arc_driven": "rad", "driver_torque": "N m", "efficiency": "",
@@ -24,6 +25,21 @@ def format_drive(summary: dict, title: str = "") -> str:
     for k, unit in units.items():
         if summary.get(k) is not None:
             lines.append(f"  {k:<{width}}  {summary[k]:.8g} {unit}".rstrip())
+    if "tight_tension" in summary or "spans" not in summary:
+        return "\n".join(lines)
+    lines.append("  span                          tension (N)")
+    for sp in summary["spans"]:
+        lines.append(f"  {sp['from'] + ' -> ' + sp['to']:<28}  {sp['tension']:12.6g}")
+    lines.append("  pulley        role       speed (rad/s)  slip arc (rad)  torque (N m)"
+                 "  hub load (N)" + ("  slip margin" if "slip_margin" in
+                                     summary["pulleys"][0] else ""))
+    for p in summary["pulleys"]:
+        hub = (p["hub_load"][0] ** 2 + p["hub_load"][1] ** 2) ** 0.5
+        row = (f"  {p['name']:<12}  {p['role']:<9}  {p['speed']:13.6g}  "
+               f"{p['slip_arc']:14.4g}  {p['torque']:12.5g}  {hub:12.5g}")
+        if "slip_margin" in p:
+            row += f"  {p['slip_margin']:11.4g}"
+        lines.append(row)
     return "\n".join(lines)
 
 
@@ -57,7 +73,7 @@ def plot_drive_run(run_dir, out=None) -> list:
 
     from ..plots.common import save_figure
     from . import plots
-    from .beam import exact_state
+    from .exact import exact_state
 
     scene, x, f, hist, summary = read_drive_run(run_dir)
     out = prepare_outdir(out or run_dir)

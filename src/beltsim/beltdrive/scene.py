@@ -29,40 +29,22 @@ from ..problem.rules import (
     RETIRED,
     STIFFNESS_RULES,
     Rule,
-    check_table,
-    number,
-    profile_extremes,
     set_scene_key,
     show,
 )
 from ..problem.tables import SceneTables
-from .analytic import LiftOffError, solve_string
+from .analytic import LiftOffError
+from .exact import string_state
 from .geometry import Geometry, GeometryError
 from .params import DriveParams, params_of
+from .pulley_tables import SHORTHAND, LoadRule, check_pulleys, specs_of
+from .pulley_tables import max_rim_speed as driver_rim_speed
 
 __all__ = ["MIN_SEGMENT_ELEMENTS", "OPTIONAL_SECTIONS", "REQUIRED", "SCHEMA", "DriveParams",
            "DriveScene", "max_rim_speed", "set_key", "validate"]
 
 #: The fewest elements on each of the loop's four segments.
 MIN_SEGMENT_ELEMENTS = 4
-
-
-def _check_load(key, value):
-    """A load torque (N m): a number >= 0 (ramped from 0) or a table of [time, value] rows."""
-    if isinstance(value, list):
-        return check_table(key, value, zero_allowed=True)
-    value = number(key, value)
-    if not value >= 0:
-        raise SceneError(key, f"must be >= 0, got {value!r}")
-    return value
-
-
-class _LoadRule(Rule):
-    def __init__(self):
-        super().__init__("load")
-
-    def check(self, key, value):
-        return _check_load(key, value)
 
 
 #: Sections of a drive scene, their keys and rules.
@@ -75,8 +57,9 @@ SCHEMA: dict[str, dict[str, Rule]] = {
         "driven_radius": POS,
         "centre_distance": POS,
         "installation_tension": POS,
+        "belt_length": POS,
         "driver_speed": PROFILE,
-        "load_torque": _LoadRule(),
+        "load_torque": LoadRule(),
         "driven_inertia": POS,
     },
     "contact": {
@@ -107,9 +90,6 @@ SCHEMA: dict[str, dict[str, Rule]] = {
     },
 }
 REQUIRED = {"belt": ("height", "width", "youngs_modulus", "poisson_ratio", "shear_factor"),
-            "drive": ("driver_radius", "driven_radius", "centre_distance",
-                      "installation_tension", "driver_speed", "load_torque",
-                      "driven_inertia"),
             "contact": ("friction",),
             "physics": ("inertia",)}
 OPTIONAL_SECTIONS = ("stiffness", "numerics")
@@ -134,6 +114,8 @@ def validate(data: dict) -> dict:
         elif key in SCHEMA:
             if not isinstance(value, dict):
                 raise SceneError(f"[{key}]", f"must be a table (section), got {show(value)}")
+        elif key == "pulley":
+            pass  # checked below, with [contact] (the pulleys' default friction)
         elif key in ("beam", "motion"):
             raise SceneError(f"[{key}]", "not in a closed drive (a scene with [drive] "
                              "describes its belt in [belt] and its motion in [drive])")
@@ -159,6 +141,9 @@ def validate(data: dict) -> dict:
         for key in keys:
             if key not in out[section]:
                 raise SceneError(f"{section}.{key}", "missing key")
+    if "pulley" in data:
+        out["pulley"] = check_pulleys(data["pulley"], out["contact"])
+    check_drive_keys(out)
     contact, physics = out["contact"], out["physics"]
     if contact["friction"] == "coulomb" and "friction_coefficient" not in contact:
         raise SceneError("contact.friction_coefficient",
@@ -185,22 +170,31 @@ def validate(data: dict) -> dict:
     if "regularisation" in num and (law in (None, "exact")):
         raise SceneError("numerics.regularisation", 'only with a regularised '
                          'numerics.friction_law ("tanh" or "sqrt"): exact friction has none')
-    drive = out["drive"]
     try:
-        Geometry(drive["driver_radius"], drive["driven_radius"], drive["centre_distance"])
+        if "pulley" not in out:  # the shorthand's rule names its own key
+            d = out["drive"]
+            Geometry(d["driver_radius"], d["driven_radius"], d["centre_distance"])
+        P = params_of(out)
     except GeometryError as exc:
         raise SceneError(str(exc)) from None
-    P = params_of(out)
+    speed_key = ("drive.driver_speed" if "pulley" not in out
+                 else f"pulley.{P.pulleys[P.driver].name}.speed")
+    if P.model == "beam":
+        for p in P.pulleys:
+            if p.side < 0:
+                raise SceneError(f"pulley.{p.name}.side", '"back" takes physics.model = '
+                                 '"string" in this version (the beam\'s friction on its '
+                                 'outer face is not in the model yet)')
     if P.rho > 0 and max_rim_speed(out) ** 2 * P.rho >= P.b1:
-        raise SceneError("drive.driver_speed", f"the rim speed reaches the belt's critical "
+        raise SceneError(speed_key, f"the rim speed reaches the belt's critical "
                          f"speed sqrt(b1 / rho) = {math.sqrt(P.b1 / P.rho):.4g} m/s")
     if P.model == "beam" and P.I > 0 and max_rim_speed(out) ** 2 * P.I >= P.a:
-        raise SceneError("drive.driver_speed", f"the rim speed reaches the beam's bending "
+        raise SceneError(speed_key, f"the rim speed reaches the beam's bending "
                          f"critical speed sqrt(a / I) = {math.sqrt(P.a / P.I):.4g} m/s "
                          f'(a - I c^2 <= 0: no steady state; physics.model = "string" has '
                          f"none)")
     try:
-        solve_string(P)
+        string_state(P)
     except LiftOffError as exc:
         raise SceneError(str(exc)) from None
     except NoSolutionError:
@@ -211,12 +205,42 @@ def validate(data: dict) -> dict:
 def set_key(data: dict, key: str, value) -> None:
     """Set ``SECTION.KEY`` (or ``title``) in a drive scene's tables; the section must be
     one a drive has (:func:`validate` checks the key and its value)."""
+    if key.startswith("pulley."):
+        parts = key.split(".")
+        tables = data.get("pulley", [])
+        names = [t.get("name") for t in tables]
+        if len(parts) != 3 or parts[1] not in names:
+            raise SceneError(key, f"expected pulley.NAME.KEY with NAME one of the scene's "
+                             f"pulleys ({', '.join(map(str, names)) or 'none'})")
+        tables[names.index(parts[1])][parts[2]] = value
+        return
     set_scene_key(data, key, value, SCHEMA, "a drive scene", known_keys=False)
 
 
 def max_rim_speed(data: dict) -> float:
-    """The largest rim speed omega1 R1 (m/s) of the driver's speed profile."""
-    return profile_extremes(data["drive"]["driver_speed"])[1] * data["drive"]["driver_radius"]
+    """The largest rim speed omega r (m/s) of the driver's speed profile."""
+    return driver_rim_speed(specs_of(data))
+
+
+def check_drive_keys(out: dict) -> None:
+    """[drive]'s keys with or without [[pulley]] tables: the shorthand's six keys, or
+    none of them, and one of installation_tension and belt_length."""
+    drive = out["drive"]
+    if "pulley" in out:
+        for key in SHORTHAND:
+            if key in drive:
+                raise SceneError(f"drive.{key}", "the two-pulley shorthand is not for a "
+                                 "scene with [[pulley]] tables (give the pulleys there)")
+    else:
+        for key in SHORTHAND:
+            if key not in drive:
+                raise SceneError(f"drive.{key}", "missing key (or give the pulleys as "
+                                 "[[pulley]] tables)")
+    given = [k for k in ("installation_tension", "belt_length") if k in drive]
+    if len(given) != 1:
+        raise SceneError("drive.installation_tension", "give exactly one of "
+                         "installation_tension and belt_length" + (
+                             "" if given else " (missing)"))
 
 
 class DriveScene(SceneTables):

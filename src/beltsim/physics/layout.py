@@ -69,14 +69,14 @@ class LoopGrid:
         return float(self.he.min())
 
 
-def loop_mesh(grid: LoopGrid, contacts, mu: float, inertia: tuple[float, ...]) -> Mesh:
+def loop_mesh(grid: LoopGrid, contacts, mu, inertia: tuple[float, ...]) -> Mesh:
     """A closed layout on a periodic grid (:class:`LoopGrid`, a node at each segment's
     start).
 
     contacts: for each contact, a
     tuple (segment index, radius, speed global) with speed global -1 for the driver (its
     rim speed prescribed) or the index of the free pulley's speed among the globals;
-    mu: the friction coefficient of every arc (0: a constant bound, perfect adhesion);
+    mu: each arc's friction coefficient (0: a constant bound, perfect adhesion);
     inertia: J of each global (0 for c).
 
     Each arc's friction acts from its entry node to its exit node (the next segment's
@@ -101,7 +101,7 @@ def loop_mesh(grid: LoopGrid, contacts, mu: float, inertia: tuple[float, ...]) -
                    (2.0 * h1 + h2) / (h1 * (h1 + h2))], axis=1)
     return Mesh(he, hb, 0, 0, 0, wf, sw, off=0,
                 cn=np.flatnonzero(seg >= 0).astype(np.int64), seg=seg,
-                seg_mu=np.full(len(contacts), float(mu)),
+                seg_mu=np.asarray(mu, dtype=float),
                 seg_radius=np.array([r for _, r, _ in contacts], dtype=float),
                 seg_speed=np.array([k for _, _, k in contacts], dtype=np.int64),
                 loop_length=loop_length, inertia=np.asarray(inertia, dtype=float))

@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..problem.drive import friction_factor, mismatch, value
+from ..problem.drive import friction_factor, mismatch, value, value_at
 
 # Loads and State are not used here: numba's cache indexes written before they moved to
 # physics.discrete name them here, and unpickling such an index must find them, or every
@@ -223,7 +223,7 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
     if closed:
         w.Rg[0] = 0.0
         for k in range(1, ng):
-            w.Rg[k] = mesh.inertia[k] * (g[k] - old.g[k]) * inv_dt + value(drive.load, t)
+            w.Rg[k] = mesh.inertia[k] * (g[k] - old.g[k]) * inv_dt + value_at(drive.load, k, t)
         if want_jac:
             w.Gc[:, :, :] = 0.0
             w.Gr[:, :, :] = 0.0

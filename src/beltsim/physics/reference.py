@@ -31,7 +31,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from ..problem.drive import friction_factor, mismatch, value
+from ..problem.drive import friction_factor, mismatch, value, value_at
 from .discrete import CENTRAL, Mesh, ModelParams, State, hermite_weights
 from .friction import ADHESION, AUGMENTATION, is_exact, law_numpy
 from .model import POWER_TERMS
@@ -341,6 +341,6 @@ def loop_residual(u, th, lam, g, old, inv_dt, t, mesh: Mesh, p: ModelParams, dri
     Rg = np.empty(len(g))
     Rg[0] = np.sum(hb * u) / mesh.loop_length
     for k in range(1, len(g)):
-        Rg[k] = (mesh.inertia[k] * (g[k] - old.g[k]) * inv_dt + value(drive.load, t)
+        Rg[k] = (mesh.inertia[k] * (g[k] - old.g[k]) * inv_dt + value_at(drive.load, k, t)
                  + np.sum(R[K == k] * F[K == k]))
     return out, Rg, F

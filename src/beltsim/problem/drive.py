@@ -46,23 +46,66 @@ class Profile(NamedTuple):
         return cls(np.zeros(0), np.zeros(0), float(value), 0.0, 0.0, float(ramp_time))
 
 
+class Profiles(NamedTuple):
+    """Several profiles in one structure, which numba reads with one type whatever
+    their number: profile k's table rows are ``times[start[k]:start[k + 1]]``."""
+
+    start: np.ndarray  # int64 (n + 1)
+    times: np.ndarray
+    values: np.ndarray
+    level: np.ndarray  # (n) each as in Profile
+    amplitude: np.ndarray
+    period: np.ndarray
+    ramp_time: np.ndarray
+
+    @classmethod
+    def of(cls, profiles) -> Profiles:
+        """The bank of a sequence of :class:`Profile`."""
+        ps = list(profiles)
+        counts = [len(p.times) for p in ps]
+        times = [p.times for p in ps] or [np.zeros(0)]
+        values = [p.values for p in ps] or [np.zeros(0)]
+        return cls(np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
+                   np.concatenate(times).astype(float),
+                   np.concatenate(values).astype(float),
+                   *(np.array([getattr(p, f) for p in ps], dtype=float)
+                     for f in ("level", "amplitude", "period", "ramp_time")))
+
+    @classmethod
+    def constants(cls, values) -> Profiles:
+        """A bank of constant profiles."""
+        return cls.of(Profile.constant(v) for v in values)
+
+    def profile(self, k: int) -> Profile:
+        """Profile k."""
+        a, b = self.start[k], self.start[k + 1]
+        return Profile(self.times[a:b], self.values[a:b], float(self.level[k]),
+                       float(self.amplitude[k]), float(self.period[k]),
+                       float(self.ramp_time[k]))
+
+
+NO_LOADS = Profiles.of([])
+
+
 class Drive(NamedTuple):
     """The drive of a run: the surface speed and the friction limit's factor, and on a
-    loop the free pulley's load.
+    loop each free pulley's load.
 
     On an open layout ``speed`` is the mismatch v(t) - c; on a loop it is the driver's
-    rim speed omega_1(t) R_1 and ``load`` the torque M(t) that the free pulley delivers.
+    rim speed omega_d(t) r_d and ``load`` the torques M_k(t) (N m) that the pulleys
+    whose speeds are the globals k deliver (entry 0, the belt speed's, is zero).
     """
 
     speed: Profile  # v(t) - c (m/s), or a loop's driver rim speed (m/s)
     friction: Profile  # f*(t) / f* (1 for perfect adhesion)
-    load: Profile = Profile.constant(0.0)  # a loop's load torque (N m)
+    load: Profiles = NO_LOADS  # a loop's load torques (N m), one per global
 
     @classmethod
-    def constant(cls, mismatch: float, load: float = 0.0) -> Drive:
-        """The full mismatch (or rim speed) and load at once and a constant friction
+    def constant(cls, mismatch: float, loads=()) -> Drive:
+        """The full mismatch (or rim speed) and loads at once and a constant friction
         limit (the steady solver)."""
-        return cls(Profile.constant(mismatch), Profile.constant(1.0), Profile.constant(load))
+        return cls(Profile.constant(mismatch), Profile.constant(1.0),
+                   Profiles.constants(loads))
 
 
 @njit(cache=True)
@@ -77,9 +120,8 @@ def ramp(t, t_ramp):
 
 
 @njit(cache=True)
-def value(profile, t):
-    """A profile's value at time t."""
-    times, vals = profile.times, profile.values
+def profile_value(times, vals, level, amplitude, period, ramp_time, t):
+    """The value at time t of the profile with these fields (:class:`Profile`)."""
     n = times.shape[0]
     if n > 0:
         if t <= times[0]:
@@ -89,10 +131,25 @@ def value(profile, t):
         k = np.searchsorted(times, t) - 1
         r = (t - times[k]) / (times[k + 1] - times[k])
         return vals[k] + r * (vals[k + 1] - vals[k])
-    out = profile.level
-    if profile.period > 0.0:
-        out += profile.amplitude * math.sin(2.0 * math.pi * t / profile.period)
-    return out * ramp(t, profile.ramp_time)
+    out = level
+    if period > 0.0:
+        out += amplitude * math.sin(2.0 * math.pi * t / period)
+    return out * ramp(t, ramp_time)
+
+
+@njit(cache=True)
+def value(profile, t):
+    """A profile's value at time t."""
+    return profile_value(profile.times, profile.values, profile.level, profile.amplitude,
+                         profile.period, profile.ramp_time, t)
+
+
+@njit(cache=True)
+def value_at(bank, k, t):
+    """The value at time t of profile k of a :class:`Profiles` bank."""
+    a, b = bank.start[k], bank.start[k + 1]
+    return profile_value(bank.times[a:b], bank.values[a:b], bank.level[k],
+                         bank.amplitude[k], bank.period[k], bank.ramp_time[k], t)
 
 
 @njit(cache=True)
@@ -121,45 +178,47 @@ def as_profile(raw, offset: float, scale: float, ramp_time: float) -> Profile:
 def drive_of(scene, ramp_time: float) -> Drive:
     """The scene's drive; ``ramp_time`` is the speed ramp (numerics.ramp_time)."""
     P = scene.params
-    raw_speed, raw = _profiles(scene)
+    raw_speed, raw = scene_profiles(scene)
     speed = as_profile(raw_speed, P.c, 1.0, ramp_time)
     friction = Profile.constant(1.0) if raw is None else as_profile(raw, 0.0, P.fstar, 0.0)
     return Drive(speed, friction)
 
 
-def _profiles(scene):
-    """The scene's two profiles: the surface speed and the friction limit of the paper's
-    belt, a drive's driver speed and load."""
+def scene_profiles(scene):
+    """The scene's profiles, the speed first: the surface speed and the friction limit
+    of the paper's belt, a drive's driver speed and loads."""
     data = scene.to_dict()
     if "drive" in data:
-        return data["drive"]["driver_speed"], data["drive"]["load_torque"]
+        P = scene.params
+        return (P.pulleys[P.driver].speed,
+                *(p.load for p in P.pulleys if p.load is not None))
     return data["motion"]["surface_speed"], data["contact"].get("max_friction")
 
 
 def profile_times(scene) -> tuple[float, ...]:
     """The times of every row of the scene's profile tables, sorted (for marking plots)."""
-    return tuple(sorted({float(row[0]) for v in _profiles(scene) if isinstance(v, list)
+    return tuple(sorted({float(row[0]) for v in scene_profiles(scene) if isinstance(v, list)
                          for row in v}))
 
 
 def has_profiles(scene) -> bool:
     """Whether the drive is more than the start-up ramp (a table or a sine anywhere)."""
-    return any(isinstance(v, (list, dict)) for v in _profiles(scene))
+    return any(isinstance(v, (list, dict)) for v in scene_profiles(scene))
 
 
 def period_of(scene) -> float | None:
     """The period of a periodic drive (a sine), None for a drive that settles."""
-    periods = [v["period"] for v in _profiles(scene) if isinstance(v, dict)]
+    periods = [v["period"] for v in scene_profiles(scene) if isinstance(v, dict)]
     return periods[0] if periods else None
 
 
 def speed_ramped(scene) -> bool:
     """Whether the surface speed ramps from c (a number or a sine, not a table)."""
-    return not isinstance(_profiles(scene)[0], list)
+    return not isinstance(scene_profiles(scene)[0], list)
 
 
 def largest_mismatch(scene) -> float:
     """max abs(v(t) - c) over the profile."""
-    lo, hi = profile_extremes(_profiles(scene)[0])
+    lo, hi = profile_extremes(scene_profiles(scene)[0])
     c = scene.params.c
     return max(abs(lo - c), abs(hi - c))

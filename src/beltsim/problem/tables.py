@@ -217,6 +217,11 @@ class SceneTables:
             lines.append(f"\n[{section}]")
             lines += [f"{key} = {toml_value(value)}"
                       for key, value in self._data[section].items()]
+        for name, tables in self._data.items():
+            if isinstance(tables, list):  # arrays of tables, e.g. a drive's [[pulley]]
+                for table in tables:
+                    lines.append(f"\n[[{name}]]")
+                    lines += [f"{key} = {toml_value(value)}" for key, value in table.items()]
         return "\n".join(lines).lstrip("\n") + "\n"
 
     @property

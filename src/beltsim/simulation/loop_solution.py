@@ -14,9 +14,10 @@ import math
 
 import numpy as np
 
+from ..beltdrive.figures import figure_keys, layout_summary
 from ..physics.friction import EXACT, saturation
 from ..physics.model import POWER_TERMS, power_terms, traction
-from ..problem.drive import value
+from ..problem.drive import value, value_at
 
 #: the drive's figures (the exact solutions give the same keys)
 SUMMARY_KEYS = ("tight_tension", "slack_tension", "belt_speed", "driven_speed", "speed_ratio",
@@ -27,8 +28,22 @@ POWER_KEYS = ("driver_power", "load_power", "damping_power", "gyroscopic_power",
               "transport_power", "energy")
 #: nodal fields of fields.csv, after x
 FIELD_KEYS = ("u", "theta", "tension", "friction", "pressure", "slip_velocity", "slip")
-#: what a history records at every check
+#: what a history records at every check (a two-pulley drive's)
 HISTORY_KEYS = ("t", "omega1", "load_torque", *SUMMARY_KEYS, *POWER_KEYS)
+#: the figures of every layout, scalars (each span's and each pulley's are in
+#: ``spans`` and ``pulleys``, and under the names of :func:`figure_keys`)
+LOOP_KEYS = ("belt_speed", "driver_torque", "efficiency", "slip_power")
+#: the errors of every layout against its exact steady state (:meth:`LoopSolution.errors`)
+LOOP_ERROR_KEYS = ("span_tension", "speed_loss", "slip_arc", "hub_load", "belt_speed",
+                   "driver_torque")
+
+
+def history_keys(P) -> tuple[str, ...]:
+    """What a history records at every check: the two-pulley keys for a two-pulley
+    drive, else the driver's speed, LOOP_KEYS, :func:`figure_keys` and the powers."""
+    if P.two_pulley:
+        return HISTORY_KEYS
+    return ("t", "omega1", *LOOP_KEYS, *figure_keys(P.layout.names), *POWER_KEYS)
 
 
 class LoopSolution:
@@ -55,7 +70,11 @@ class LoopSolution:
         self.wf = m.wf
         self.state = state.copy()
         drive = disc.steady_drive() if t is None else disc.drive
-        self.rim1, self.load = value(drive.speed, t or 0.0), value(drive.load, t or 0.0)
+        self.rim1 = value(drive.speed, t or 0.0)
+        #: each free pulley's load torque (N m) at this time, by its global
+        self.loads = np.array([value_at(drive.load, k, t or 0.0)
+                               for k in range(disc.n_globals)])
+        self.load = self.loads[1]
         # the kernel's power terms of the rows: slip, damping, gyroscopic
         terms = np.zeros(len(POWER_TERMS))
         power_terms(state, t or 0.0, disc.mesh, disc.model, drive, disc.loads, terms)
@@ -63,6 +82,10 @@ class LoopSolution:
         self.c, self.omega2 = float(state.g[0]), float(state.g[1])
         self.cdot = float(state.gd[0])
         self.omega2_rate = float(state.gd[1])
+        rd = self.params.pulleys[self.params.driver].radius
+        #: each pulley's speed (rad/s): the driver's prescribed, the others' unknowns
+        self.speeds = np.array([self.rim1 / rd if k < 0 else float(state.g[k])
+                                for k in disc.speed_global])
         self._fields = self._read(disc.model)
 
     def _read(self, prm) -> dict:
@@ -78,8 +101,7 @@ class LoopSolution:
         R = np.where(on, m.seg_radius[np.maximum(m.seg, 0)], 1.0)
         p = np.where(on, (tension - P.rho * self.c**2) / R, 0.0)
         f = traction(s.fnode, m.wf)
-        rim = np.where(on & (m.seg_speed[np.maximum(m.seg, 0)] >= 1),
-                       self.omega2 * P.geometry.R2, self.rim1)
+        rim = np.where(on, self.speeds[np.maximum(m.seg, 0)] * R, 0.0)
         vrel = np.where(on, self.c * (1.0 + P.N0 / P.b1 + epsb) + s.ud + lever * s.td - rim,
                         0.0)
         # sliding: the ratio at the bound (exact law) or saturated (a regularised law)
@@ -102,14 +124,15 @@ class LoopSolution:
         return dict(self._fields)
 
     # figures --------------------------------------------------------
-    def span_tensions(self) -> tuple[float, float]:
-        """Mean axial force over the tight and the slack span: N0 + b1 (u_end - u_start) /
-        l, exact for the nodal values (the integral of the elements' strains)."""
-        P, u = self.params, self.state.u
-        k = [int(np.argmin(np.abs(self.x - b))) for b in P.geometry.bounds[:4]]
-        ls = P.geometry.span
-        return (P.N0 + P.b1 * (u[k[0]] - u[k[3]]) / ls,
-                P.N0 + P.b1 * (u[k[2]] - u[k[1]]) / ls)
+    def span_tensions(self) -> np.ndarray:
+        """Each span's mean axial force (N), in the belt's order (span i from pulley i to
+        i + 1): N0 + b1 (u_end - u_start) / l, exact for the nodal values (the integral of
+        the elements' strains)."""
+        P, u, first = self.params, self.state.u, self.disc.grid.first
+        n = len(u)
+        spans = P.layout.spans
+        return np.array([P.N0 + P.b1 * (u[first[2 * i + 2] % n] - u[first[2 * i + 1]])
+                         / spans[i] for i in range(len(spans))])
 
     def slip_arcs(self) -> tuple[float, float]:
         """The slip arc of each pulley (rad): the sliding nodes' contact lengths plus the
@@ -141,12 +164,20 @@ class LoopSolution:
                     phi = min(1.0, max(0.0, (lam[j] - lam_s) / (sign - lam_s)))
                     length += m.wf[j] * phi
             out.append(length / m.seg_radius[a])
-        return out[0], out[1]
+        return out
+
+    def torques(self) -> np.ndarray:
+        """The torque (N m) the driver puts into the belt and each other pulley takes out
+        of it: r times the friction on its arc, signed so that both are positive in a
+        driving drive."""
+        F, m = self.state.fnode, self.mesh
+        return np.array([(1.0 if k < 0 else -1.0) * m.seg_radius[a]
+                         * float(np.sum(F[m.seg == a]))
+                         for a, k in enumerate(self.disc.speed_global)])
 
     def driver_torque(self) -> float:
-        """M1 = R1 (the friction on the driver's arc) (N m)."""
-        F = self.state.fnode
-        return self.params.geometry.R1 * float(np.sum(F[self.mesh.seg == 0]))
+        """The driver's torque: r_d (the friction on its arc) (N m)."""
+        return float(self.torques()[self.params.driver])
 
     @property
     def monitor(self) -> float:
@@ -171,7 +202,7 @@ class LoopSolution:
         grid's error).
         """
         P, m, f = self.params, self.mesh, self._fields
-        c, w2 = self.c, self.omega2
+        c = self.c
         F = self.state.fnode
         ud, td = f["u_t"], f["theta_t"]
         du = np.diff(np.append(f["u"], f["u"][0]))
@@ -179,14 +210,15 @@ class LoopSolution:
         he, hb = m.he, m.hb
         strain_u, strain_t = float(np.sum(du * du / he)), float(np.sum(dth * dth / he))
         B, A = P.b1 - P.rho * c * c, P.a - P.I * c * c
-        energy = (0.5 * P.rho * P.geometry.loop_length * c * c
+        g = self.state.g
+        energy = (0.5 * P.rho * P.layout.loop_length * c * c
                   + 0.5 * float(np.sum(hb * (P.rho * ud * ud + P.I * td * td)))
                   + 0.5 * (B * strain_u + A * strain_t
                            + P.b2 * float(np.sum(hb * f["theta"] ** 2)))
-                  + 0.5 * P.J2 * w2 * w2)
+                  + 0.5 * float(np.sum(m.inertia[1:] * g[1:] ** 2)))
         return {
-            "driver_power": self.driver_torque() * self.rim1 / P.geometry.R1,
-            "load_power": self.load * w2,
+            "driver_power": self.driver_torque() * self.speeds[P.driver],
+            "load_power": float(np.sum(self.loads[1:] * g[1:])),
             "damping_power": float(self._terms["damping"]),
             "gyroscopic_power": float(self._terms["gyroscopic"]),
             "transport_power": float(-c * np.sum(F * (P.N0 / P.b1 + f["bottom_strain"])))
@@ -195,23 +227,32 @@ class LoopSolution:
         }
 
     def summary(self, path: bool = False) -> dict:
-        """The drive's figures (SUMMARY_KEYS), the driver's and the load's power, the
-        power terms and, with ``path``, the driver's speed and the load of this time."""
+        """The drive's figures: LOOP_KEYS, ``spans`` (a list in the belt's order of
+        {from, to, tension}), ``pulleys`` (a list of {name, role, speed, slip_arc, wrap,
+        torque, hub_load [Fx, Fy]}), each span's and pulley's figures under
+        :func:`figure_keys`' names, the power terms, a two-pulley drive's SUMMARY_KEYS
+        and, with ``path``, the driver's speed and the load of this time."""
         P = self.params
-        T1, T2 = self.span_tensions()
-        M1 = self.driver_torque()
-        s1, s2 = self.slip_arcs()
-        omega1 = self.rim1 / P.geometry.R1
-        slip_power = float(self._terms["slip"])
-        ratio = self.omega2 * P.geometry.R2 / self.rim1 if self.rim1 > 0 else math.nan
-        eff = (self.load * self.omega2 / (M1 * omega1) if M1 * omega1 > 0 and self.load > 0
-               else math.nan)
-        out = {"tight_tension": T1, "slack_tension": T2, "belt_speed": self.c,
-               "driven_speed": self.omega2, "speed_ratio": ratio, "slip_arc_driver": s1,
-               "slip_arc_driven": s2, "driver_torque": M1, "efficiency": eff,
-               "slip_power": slip_power, **self.power_terms()}
+        T = self.span_tensions()
+        torques = self.torques()
+        arcs = self.slip_arcs()
+        speeds = self.speeds
+        d = P.driver
+        delivered = float(np.sum(self.loads[1:] * self.state.g[1:]))
+        inp = torques[d] * speeds[d]
+        eff = delivered / inp if inp > 0 and delivered > 0 else math.nan
+        out = {"belt_speed": self.c, "driver_torque": float(torques[d]), "efficiency": eff,
+               "slip_power": float(self._terms["slip"]),
+               **layout_summary(P.layout, [p.role for p in P.pulleys], P.rho, self.c, T,
+                                 speeds, arcs, torques)}
+        if P.two_pulley:
+            ratio = self.omega2 * P.geometry.R2 / self.rim1 if self.rim1 > 0 else math.nan
+            out.update({"tight_tension": float(T[1]), "slack_tension": float(T[0]),
+                        "driven_speed": self.omega2, "speed_ratio": ratio,
+                        "slip_arc_driver": arcs[0], "slip_arc_driven": arcs[1]})
+        out.update(self.power_terms())
         if path:
-            out.update(omega1=omega1, load_torque=self.load)
+            out.update(omega1=float(speeds[d]), load_torque=self.load)
         return out
 
     def snapshot_arrays(self, snaps: dict) -> dict:
@@ -221,16 +262,18 @@ class LoopSolution:
         from ..physics.discrete import State
 
         out = {k: [] for k in ("u", "theta", "friction", "tension", "slip", "belt_speed",
-                               "driven_speed")}
+                               "driven_speed", "globals")}
         N = len(self.x)
         for i in range(len(snaps["t"])):
             st = State(snaps["u"][i], snaps["theta"][i], snaps["lam"][i], np.zeros(N),
-                       np.zeros(N), snaps["fnode"][i], snaps["g"][i], np.zeros(2))
+                       np.zeros(N), snaps["fnode"][i], snaps["g"][i],
+                       np.zeros(len(snaps["g"][i])))
             f = LoopSolution(self.disc, st, snaps["t"][i])._fields
             for k in ("u", "theta", "friction", "tension", "slip"):
                 out[k].append(f[k])
             out["belt_speed"].append(st.g[0])
             out["driven_speed"].append(st.g[1])
+            out["globals"].append(st.g)
         return {k: np.array(v) for k, v in out.items()}
 
     # outcomes ---------------------------------------------------------
@@ -245,21 +288,40 @@ class LoopSolution:
                 f"lifts off; this model does not describe lift-off)")
 
     def sliding_arc(self) -> str | None:
-        """The pulley whose whole wrap slides ("driver", "driven pulley"), or None."""
+        """The name of a pulley whose whole wrap slides, or None."""
         slide = self._fields["slip"]
-        for a, name in enumerate(("driver", "driven pulley")):
+        for a, p in enumerate(self.params.pulleys):
             if np.all(slide[self.mesh.seg == a]):
-                return name
+                return p.name
         return None
 
     # errors -----------------------------------------------------------
     def errors(self, ref) -> dict:
-        """Relative errors of the figures against the exact steady state ``ref`` (speed
-        loss 1 - speed_ratio compared as itself; slip arcs relative to the wrap)."""
+        """Errors of the figures against the exact steady state ``ref``: LOOP_ERROR_KEYS
+        (the largest over the spans or pulleys: tensions and hub loads relative to the
+        largest span tension, speed losses 1 - omega r / (omega_d r_d) relative to the
+        largest, slip arcs relative to the wrap) and, for a two-pulley drive, its figures
+        one by one (relative; slip arcs over the wrap)."""
         mine, ex = self.summary(), ref.summary()
-        out = {}
-        keys = ["tight_tension", "slack_tension", "belt_speed", "driven_speed",
-                "driver_torque"]
+        P = self.params
+        scale = max(s["tension"] for s in ex["spans"])
+        out = {"span_tension": max(abs(a["tension"] - b["tension"]) / scale
+                                   for a, b in zip(mine["spans"], ex["spans"])),
+               "hub_load": max(math.dist(a["hub_load"], b["hub_load"]) / scale
+                               for a, b in zip(mine["pulleys"], ex["pulleys"]))}
+        rim = P.driver_rim_speed
+        loss = [1.0 - p["speed"] * q.radius / rim for p, q in zip(mine["pulleys"], P.pulleys)]
+        loss_ex = [1.0 - p["speed"] * q.radius / rim for p, q in zip(ex["pulleys"], P.pulleys)]
+        top = max(abs(v) for v in loss_ex)
+        out["speed_loss"] = (max(abs(a - b) for a, b in zip(loss, loss_ex)) / top if top
+                             else max(abs(v) for v in loss))
+        out["slip_arc"] = max(abs(a["slip_arc"] - b["slip_arc"]) / a["wrap"]
+                              for a, b in zip(mine["pulleys"], ex["pulleys"]))
+        for key in ("belt_speed", "driver_torque"):
+            out[key] = (mine[key] - ex[key]) / abs(ex[key]) if ex[key] else abs(mine[key])
+        if not P.two_pulley:
+            return out
+        keys = ["tight_tension", "slack_tension", "driven_speed"]
         if self.params.mu is not None:
             # with perfect adhesion every node sticks: the exits' dissipation is not a
             # nodal slip power but the transport term's (power_terms)

@@ -12,7 +12,8 @@ import numpy as np
 
 from ..errors import NoSolutionError
 from ..problem.drive import mismatch as mismatch_at
-from .loop_solution import HISTORY_KEYS, LoopSolution
+from ..problem.drive import period_of
+from .loop_solution import LoopSolution, figure_keys, history_keys
 from .result import RunStatus, reference_of
 from .solution import DiscreteReference, DiscreteSolution
 
@@ -97,11 +98,24 @@ class LoopReadout(Readout):
         self.disc = disc
         P = disc.params
         self.model = "drive"
-        self.history_keys = HISTORY_KEYS[:1] + ("rate",) + HISTORY_KEYS[1:]
-        self.monitor_scale = 1e-3 * P.N0 * P.geometry.R1
-        self.periodic_keys = ("driver_torque", "driven_speed", "tight_tension",
-                              "slack_tension", "belt_speed")
-        self.second_scale = P.omega1 * P.geometry.R1 / P.geometry.R2
+        keys = history_keys(P)
+        self.history_keys = keys[:1] + ("rate",) + keys[1:]
+        rd = P.pulleys[P.driver].radius
+        self.monitor_scale = 1e-3 * P.N0 * rd
+        if P.two_pulley:
+            self.periodic_keys = ("driver_torque", "driven_speed", "tight_tension",
+                                  "slack_tension", "belt_speed")
+            self.second_scale = P.omega1 * rd / P.geometry.R2
+        else:
+            # the first free pulley's speed second, over the driver's speed ratio
+            first = next(p for p in P.pulleys if p.role != "driver")
+            spans = [k for k in figure_keys(P.layout.names) if k.startswith("tension[")]
+            self.periodic_keys = ("driver_torque", f"speed[{first.name}]", "belt_speed",
+                                  *spans)
+            self.second_scale = P.driver_rim_speed / first.radius
+        #: each global's speed scale: the rim speed, and its radius for a pulley's
+        radii = np.array([1.0] + [p.radius for p in P.pulleys if p.role != "driver"])
+        self._radii = radii
         self._sliding = 0
 
     def solution(self, state, t: float, transient: bool):
@@ -111,16 +125,17 @@ class LoopReadout(Readout):
 
     def monitor(self, state) -> float:
         """The driver's torque (N m)."""
-        m = self.disc.mesh
-        return self.disc.params.geometry.R1 * float(np.sum(state.fnode[m.seg == 0]))
+        m, P = self.disc.mesh, self.disc.params
+        d = P.driver
+        return P.pulleys[d].radius * float(np.sum(state.fnode[m.seg == d]))
 
     def rate(self, state) -> float:
-        """The largest rate of the belt's and the driven pulley's speeds and of u, each
-        over its scale (the rim speed, the creep speed) times the transit time."""
+        """The largest rate of the belt's and the pulleys' speeds and of u, each over its
+        scale (the rim speed, the creep speed) times the transit time."""
         P = self.disc.params
-        rim = P.omega1 * P.geometry.R1
+        rim = P.driver_rim_speed
         creep = rim * P.N0 / P.b1
-        return float(max(abs(state.gd[0]) / rim, abs(state.gd[1]) * P.geometry.R2 / rim,
+        return float(max(np.max(np.abs(state.gd) * self._radii) / rim,
                          np.max(np.abs(state.ud)) / creep) * self.disc.window)
 
     def outcome(self, sim):
@@ -131,20 +146,21 @@ class LoopReadout(Readout):
         if why is not None:
             return RunStatus.LIFT_OFF, f"t = {sim.t:.6g} s: {why}"
         which = sol.sliding_arc()
-        self._sliding = self._sliding + 1 if which and sim.state.gd[1] < 0 else 0
+        self._sliding = (self._sliding + 1 if which and np.any(sim.state.gd[1:] < 0)
+                         else 0)
         if self._sliding >= GROSS_SLIP_CHECKS:
             return RunStatus.GROSS_SLIP, (
-                f"t = {sim.t:.6g} s: the belt slides over the {which}'s whole wrap and the "
-                f"driven pulley slows down ({sim.state.g[1]:.6g} rad/s)")
+                f"t = {sim.t:.6g} s: gross slip at {which}: the belt slides over its "
+                f"whole wrap and a pulley slows down")
         return None
 
     @staticmethod
     def exact(scene):
         """The drive's exact steady state (the string's or the beam's, as the scene's
         model), or None: a periodic drive, or a load beyond the capacity."""
-        from ..beltdrive.beam import exact_state
+        from ..beltdrive.exact import exact_state
 
-        if any(isinstance(scene.drive[k], dict) for k in ("driver_speed", "load_torque")):
+        if period_of(scene) is not None:
             return None  # a periodic drive never settles
         P = scene.params
         try:

@@ -12,7 +12,7 @@ from ..physics.discrete import Loads, Mesh, ModelParams, State, mesh_of, model_p
 from ..physics.friction import EXACT, LINEAR, has_dual
 from ..physics.grid import Grid
 from ..physics.layout import LoopGrid, loop_mesh, loop_params
-from ..problem.drive import Drive, Profile, as_profile, drive_of
+from ..problem.drive import Drive, Profile, Profiles, as_profile, drive_of
 from ..problem.scene import Scene
 from .settings import Numerics, build_grid, resolve, resolve_loop
 
@@ -78,14 +78,14 @@ class Discretisation:
 
 
 class LoopDiscretisation(Discretisation):
-    """A closed drive on its periodic grid: the loop layout (the driver's arc, the slack
-    span, the driven arc, the tight span), its two global unknowns (the belt speed c and
-    the driven pulley's speed omega_2) and the named structures the kernels read.
+    """A closed drive on its periodic grid: the loop layout (each pulley's arc and the
+    span to the next, in the belt's order), its global unknowns (the belt speed c and
+    the speed of every pulley but the driver, in the pulleys' order) and the named
+    structures the kernels read.
 
     ``grid`` replaces the default grid (a :class:`~beltsim.physics.layout.LoopGrid`).
     """
 
-    n_globals = 2
     closed = True
 
     def __init__(self, scene, grid: LoopGrid | None = None):
@@ -93,10 +93,19 @@ class LoopDiscretisation(Discretisation):
         self.params = P = scene.params
         num = resolve_loop(scene, None if grid is None else grid.n_elements)
         self.numerics: Numerics = num
-        g = P.geometry
-        self.grid = grid if grid is not None else LoopGrid.build(g.lengths, num.elements)
-        self.mesh: Mesh = loop_mesh(self.grid, [(0, g.R1, -1), (2, g.R2, 1)],
-                                    0.0 if P.mu is None else P.mu, (0.0, P.J2))
+        layout = P.layout
+        self.grid = grid if grid is not None else LoopGrid.build(layout.lengths,
+                                                                 num.elements)
+        pulleys = P.pulleys
+        #: each pulley's global unknown (its speed), -1 for the driver
+        free = np.array([p.role != "driver" for p in pulleys])
+        self.speed_global = np.where(free, np.cumsum(free), -1)
+        self.n_globals = len(pulleys)  # c and every pulley's speed but the driver's
+        self.mesh: Mesh = loop_mesh(
+            self.grid, [(2 * i, p.radius, int(k)) for i, (p, k)
+                        in enumerate(zip(pulleys, self.speed_global))],
+            [0.0 if mu is None else mu for mu in P.mus],
+            (0.0, *(p.inertia for p in pulleys if p.role != "driver")))
         code = num.law_code
         self.model: ModelParams = loop_params(
             a=P.a, b1=P.b1, b2=P.b2, rho=P.rho, I=P.I, lever=P.lever,
@@ -104,29 +113,34 @@ class LoopDiscretisation(Discretisation):
             N0=P.N0, law=code, dual=int(has_dual(code) and code != LINEAR and code < EXACT),
             regularisation=num.regularisation, friction_scale=num.friction_scale,
             gyro=num.gyro_code)
-        d = scene.drive
-        # the rim speed omega_1(t) R_1 and the load M(t): numbers and sines ramp from 0
-        self.drive = Drive(as_profile(d["driver_speed"], 0.0, 1.0 / g.R1, num.ramp_time),
+        driver = pulleys[P.driver]
+        free = [p for p in pulleys if p.role != "driver"]
+        # the rim speed omega_d(t) r_d and the loads M_k(t): numbers and sines ramp from 0
+        self.drive = Drive(as_profile(driver.speed, 0.0, 1.0 / driver.radius, num.ramp_time),
                            Profile.constant(1.0),
-                           as_profile(d["load_torque"], 0.0, 1.0, num.ramp_time))
+                           Profiles.of([Profile.constant(0.0)] + [
+                               Profile.constant(0.0) if p.load is None
+                               else as_profile(p.load, 0.0, 1.0, num.ramp_time)
+                               for p in free]))
         self.loads: Loads = Loads.none(self.grid.n_elements)
-        rim = P.omega1 * g.R1
+        rim = P.driver_rim_speed
         strain = P.N0 / P.b1
-        L = g.loop_length
+        L = layout.loop_length
+        radii = np.array([p.radius for p in free])
         self.scales: Scales = Scales(P.N0, P.N0 * max(P.h, 1e-300), L * strain, strain,
-                                     np.array([rim, rim / g.R2]),
-                                     np.array([L * strain, P.N0 * g.R2]))
+                                     np.concatenate([[rim], rim / radii]),
+                                     np.concatenate([[L * strain], P.N0 * radii]))
 
     @property
     def window(self) -> float:
         """The loop's transit time (s): how long the belt takes once round it."""
-        return self.params.geometry.loop_length / (self.params.omega1
-                                                   * self.params.geometry.R1)
+        return self.params.layout.loop_length / self.params.driver_rim_speed
 
     def steady_drive(self, s: float = 1.0) -> Drive:
-        """The final rim speed and load (``s`` is the open layout's continuation)."""
+        """The final rim speed and loads (``s`` is the open layout's continuation)."""
         P = self.params
-        return Drive.constant(P.omega1 * P.geometry.R1, P.M2)
+        return Drive.constant(P.driver_rim_speed,
+                              (0.0, *(p.final_load for p in P.pulleys if p.role != "driver")))
 
     def with_grid(self, grid: LoopGrid) -> LoopDiscretisation:
         """The same drive on another grid."""

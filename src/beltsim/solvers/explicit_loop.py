@@ -52,7 +52,7 @@ from numba import njit
 from ..physics.discrete import hermite_weights, load_at
 from ..physics.friction import ADHESION, EXACT, LINEAR, RAMP, SQRT, TANH
 from ..physics.model import wrap
-from ..problem.drive import friction_factor, value
+from ..problem.drive import friction_factor, value, value_at
 from .explicit_friction import A_EST, ALPHA, C_EST, SAFE_FASTMATH, _friction_scalar, _law
 
 # columns of the arcs' trial array (a row per node): a sweep's results, committed when
@@ -276,7 +276,6 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co, arc
         gauge += hb[j] * u[j]
     ff = friction_factor(drive, t)
     rim1 = value(drive.speed, t)
-    load = value(drive.load, t)
     for k in range(1, dg.shape[0]):
         dg[k] = 0.0
     for a in range(arcs.shape[0]):
@@ -288,6 +287,7 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co, arc
             # the arc with its pulley's increment: G = sum F_j(rim(G)), rim(G) =
             # R (omega_b + A_EST dt (-M - R G) / J - C_EST Delta omega_last)
             R, J = mesh.seg_radius[s], mesh.inertia[K]
+            load = value_at(drive.load, K, t)
             rim0 = R * (gb[K] + A_EST * dt * (-load) / J - C_EST * dgp[K])
             drim = -A_EST * dt * R * R / J
             G = gtot[K]

@@ -33,7 +33,13 @@ from ..physics.friction import AUGMENTATION, LAW_CODES, is_exact
 from ..physics.grid import Grid, make_grid
 from ..problem import analytic
 from ..problem.analytic import decay_rates
-from ..problem.drive import largest_mismatch, period_of, profile_times, speed_ramped
+from ..problem.drive import (
+    largest_mismatch,
+    period_of,
+    profile_times,
+    scene_profiles,
+    speed_ramped,
+)
 from ..problem.scene import Scene
 from ..problem.validation import Params
 from . import registry
@@ -289,8 +295,7 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
         raise SceneError(reason)
     transit = transit_time(P)
     ramp_time = nm.get("ramp_time", 2.0 * transit)
-    settle = max([ramp_time, *(v[-1][0] for v in (scene.drive["driver_speed"],
-                                                  scene.drive["load_torque"])
+    settle = max([ramp_time, *(v[-1][0] for v in scene_profiles(scene)
                                if isinstance(v, list))])
     dt = nm.get("dt", max(ramp_time, transit) / FIRST_STEPS)
     steady_tol = nm.get("steady_tol", 1e-7)
@@ -306,13 +311,13 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
                          "other schemes' steps adapt)")
     creep = creep_speed(P)
     # the lowest string frequency of the longer free span (pi sqrt(N0 / rho) / l)
-    omega1 = math.pi * math.sqrt(P.N0 / P.rho) / max(P.geometry.lengths[1::2]) \
+    omega1 = math.pi * math.sqrt(P.N0 / P.rho) / max(P.layout.spans) \
         if P.rho > 0.0 else 0.0
     friction_scale = 1.0
     if P.mu is None:
         # adhesion's reaction, scaled as the pretension's pressure on the driver
         law, regularisation = "adhesion", creep
-        friction_scale = P.N0 / P.geometry.R1
+        friction_scale = P.N0 / P.pulleys[P.driver].radius
     else:
         law = nm.get("friction_law", "exact")
         regularisation = (creep if law == "exact" else

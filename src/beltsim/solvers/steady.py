@@ -23,7 +23,8 @@ import copy
 
 import numpy as np
 
-from ..beltdrive.analytic import creep_speed, solve_string
+from ..beltdrive.analytic import creep_speed
+from ..beltdrive.exact import string_state
 from ..errors import FailureKind, NumericalError
 from ..physics.discrete import Loads, mesh_of, regularised
 from ..physics.friction import EXACT, TANH, is_exact
@@ -159,7 +160,7 @@ class SteadyScheme(NewtonScheme):
         d = self.disc
         model = d.model
         if d.grid.n_elements > COARSEST * LOOP_ELEMENTS:
-            coarse = d.with_grid(LoopGrid.build(d.params.geometry.lengths,
+            coarse = d.with_grid(LoopGrid.build(d.params.layout.lengths,
                                                 d.grid.n_elements // COARSENING))
             level, coarse_state, before = self._coarse_level(coarse)
             stats = self.work.stats[0]
@@ -250,19 +251,21 @@ def creep_state(d, state) -> None:
     """A loop's state at the creep theory's steady state (the extensible string's exact
     one; theta = 0): Newton's start. Raises NoSolutionError where the string has none
     (gross slip, lift-off)."""
-    sol = solve_string(d.params)
+    sol = string_state(d.params)
     P, x = d.params, d.grid.x
     state.assign(type(state).zeros(len(x), d.n_globals))
     state.u[:] = sol.displacement(x)
     cn = d.mesh.cn
     if P.mu is not None:
         p = sol.pressure(x[cn])
-        lam = np.where(p > 0, -sol.friction(x[cn]) / (P.mu * np.where(p > 0, p, 1.0)), 0.0)
+        mu = d.mesh.seg_mu[d.mesh.seg[cn]]
+        lam = np.where(p > 0, -sol.friction(x[cn]) / (mu * np.where(p > 0, p, 1.0)), 0.0)
         # inside (-1, 1): the regularised laws' inverse is singular on the boundary
         state.lam[cn] = np.clip(lam, -1.0 + 1e-9, 1.0 - 1e-9)
     else:
         state.lam[cn] = -sol.friction(x[cn]) / d.model.friction_scale
-    state.g[:] = (sol.c, sol.omega2)
+    speeds = np.asarray(sol.speeds)
+    state.g[:] = (sol.c, *speeds[d.speed_global >= 0])
 
 
 def interpolate_loop(coarse, state, fine, contact, out) -> None:
