@@ -52,3 +52,20 @@ def test_analytic_writes_a_folder_of_its_own_scene_and_clears_what_it_did_not_wr
     assert proc.returncode == 0, proc.stderr
     assert {p.name for p in own.iterdir()} == {"summary.json"}
     assert "slip_arc_driver" in (own / "summary.json").read_text()
+
+
+@pytest.mark.cli
+def test_run_clears_an_earlier_runs_snapshots_it_did_not_write(tmp_path):
+    """A run without snapshots leaves none of an earlier run's in its folder: `beltsim
+    animate --from DIR` would draw them as this run's."""
+    from helpers import cli
+
+    small = ("run", "paper_quasistatic", "--set", "numerics.elements=60", "--quiet",
+             "--out", tmp_path)
+    proc = cli(*small, "--snapshots", "0.05", timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "snapshots.npz").is_file()
+    proc = cli(*small, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert {p.name for p in tmp_path.iterdir()} == {
+        "summary.json", "fields.csv", "history.csv", "scene.toml"}

@@ -64,6 +64,8 @@ def _progress(args) -> bool:
 
 #: What 'beltsim analytic' writes: both for a straight belt, the summary for a drive
 ANALYTIC_FILES = ("summary.json", "fields.csv")
+#: The figures of 'beltsim sweep', each for one key: another key's sweep removes them
+SWEEP_FIGURES = ("creep_collapse.png", "characteristic.png")
 
 
 def _analytic_outdir(args):
@@ -104,7 +106,7 @@ def cmd_run(args):
     from pathlib import Path
 
     from .io.files import prepare_outdir
-    from .io.results import CHECKPOINT, save_run
+    from .io.results import CHECKPOINT, SNAPSHOTS, save_run
     from .simulation.controller import Simulation
 
     if args.snapshots is not None and not args.snapshots > 0:
@@ -132,7 +134,9 @@ def cmd_run(args):
               f"'beltsim run --resume {out}'", file=sys.stderr)
         return 130
     result.reference = sim.readout.reference()
-    save_run(result, out)
+    written = save_run(result, out)
+    # an earlier run's snapshots would animate as this run's
+    _clear_stale(out, (SNAPSHOTS,), written=[p.name for p in written])
     summary = result.summary()
     print(format_summary(summary, title=title))
     print(format_run(summary))
@@ -263,6 +267,7 @@ def cmd_sweep(args):
     data = [[np.nan if v is None else v for v in col] for col in data]
     write_csv(out / "sweep.csv", cols, data)
     print(f"wrote {out / 'sweep.csv'}")
+    _clear_stale(out, SWEEP_FIGURES, written=("creep_collapse.png",) if collapse else ())
     if collapse:
         save_figure(creep_collapse, out / "creep_collapse.png", rows, title=scene.title,
                     dpi=CREEP_COLLAPSE_DPI)
@@ -295,7 +300,9 @@ def _drive_sweep(args, scene, key, values):
         [np.nan if r[c] is None else r[c] for r in rows] for c in cols[2:]]
     write_csv(out / "sweep.csv", cols, data, text_columns=("status",))
     print(f"wrote {out / 'sweep.csv'}")
-    if key == "drive.load_torque":
+    characteristic = key == "drive.load_torque"
+    _clear_stale(out, SWEEP_FIGURES, written=("characteristic.png",) if characteristic else ())
+    if characteristic:
         ok = [r for r in rows if r["converged"]]
         fig = save_figure(
             plot_characteristic, out / "characteristic.png",
