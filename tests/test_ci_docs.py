@@ -73,3 +73,61 @@ def test_a_page_that_needs_the_network_or_misses_its_mathjax_fails(
 
 def test_an_empty_folder_is_not_a_built_site(tmp_path):
     assert _checker().main([str(tmp_path)]) == 1
+
+
+# the Python tutorial's shown values (.ci/run_tutorial.py; CI runs the page as a notebook)
+
+def _tutorial():
+    spec = importlib.util.spec_from_file_location("run_tutorial",
+                                                  ROOT / ".ci" / "run_tutorial.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize("comment, shown", [
+    (" 100000.0", "100000.0"),
+    (" None: the default time step applies", "None"),
+    (" (7123.6..., 0.6341...): N, and the slip start in m", "(7123.6..., 0.6341...)"),
+    (" (<RunStatus.CONVERGED: 'converged'>, None)", "(<RunStatus.CONVERGED: 'converged'>, None)"),
+    (" 'newton', as summary.json records it", "'newton'"),
+    (" 'a: b, c'", "'a: b, c'"),
+    (" the grid's nodes (m)", None),
+    (" b1 - rho c^2 = 284000.0 N", None),
+])
+def test_a_comment_shows_the_value_before_its_prose(comment, shown):
+    assert _tutorial().shown_value(comment) == shown
+
+
+def test_an_ellipsis_stands_for_any_text_and_nothing_else_does():
+    match = _tutorial().ellipsis_match
+    names = "('drive_flat', 'drive_load_step', 'load_drop', 'paper_slip', 'speed_step')"
+    assert match("('drive_flat', 'drive_load_step', 'load_drop', ..., 'speed_step')", names)
+    assert not match("('drive_flat', 'load_drop', ..., 'speed_step')", names)
+    assert not match("('drive_flat', ..., 'speed_sine')", names)
+    assert match("(7123.6..., 0.6341...)", "(7123.61, 0.63415)")
+    assert not match("(7123.6..., 0.6341...)", "(7123.7, 0.63415)")
+    assert not match("ab...ba", "aba")  # the two ends may not overlap
+    assert match("True", "True") and not match("True", "False")
+
+
+def test_a_line_that_shows_a_value_is_checked_and_keeps_its_value():
+    tutorial = _tutorial()
+    source = "\n".join([
+        "x = 2                 # 2: an assignment shows nothing",
+        "x, x + 1              # (2, 3)",
+        "print(x)              # 2: printed, not a value",
+        "for i in ():",
+        "    i                 # 1",
+        "x                     # the value, in words",
+        "x * 2                 # 5",
+    ])
+    lines = tutorial.checked(source, 10).splitlines()
+    assert lines[0] == source.splitlines()[0] and lines[2:6] == source.splitlines()[2:6]
+    assert lines[1].startswith("_shown((x, x + 1), '(2, 3)', 11)")
+    assert lines[6].startswith("_shown((x * 2), '5', 16)")
+    namespace = {"_shown": tutorial._shown}
+    exec("\n".join(lines[:6]), namespace)
+    assert eval(lines[1].split("  #")[0], namespace) == (2, 3)
+    with pytest.raises(AssertionError, match="tutorial line 16 shows 5, the code gives 4"):
+        exec(lines[6], namespace)
