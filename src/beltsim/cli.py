@@ -64,7 +64,7 @@ def _progress(args) -> bool:
 
 #: What 'beltsim analytic' writes: both for a straight belt, the summary for a drive
 ANALYTIC_FILES = ("summary.json", "fields.csv")
-#: The figures of 'beltsim sweep', each for one key: another key's sweep removes them
+#: The figures of 'beltsim sweep', each for one key: a sweep removes the one it does not draw
 SWEEP_FIGURES = ("creep_collapse.png", "characteristic.png")
 
 
