@@ -527,7 +527,8 @@ def build_parser():
     p.set_defaults(func=cmd_stability)
 
     p = sub.add_parser("bench", help="wall times of the default and steady runs, the explicit "
-                       "kernel's speed and a cold start (peers: benchmarks/ of the repository)")
+                       "kernel's speed, import beltsim, a warm run end to end and a cold start "
+                       "(peers: benchmarks/ of the repository)")
     _add_scene_args(p, nargs="?", default="paper_slip",
                     help="scene file or shipped scene name (default paper_slip)")
     p.add_argument("--elements", type=int, default=None,
