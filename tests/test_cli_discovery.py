@@ -55,9 +55,10 @@ def test_analytic_writes_a_folder_of_its_own_scene_and_clears_what_it_did_not_wr
 
 
 @pytest.mark.cli
-def test_run_clears_an_earlier_runs_snapshots_it_did_not_write(tmp_path):
-    """A run without snapshots leaves none of an earlier run's in its folder: `beltsim
-    animate --from DIR` would draw them as this run's."""
+def test_run_clears_an_earlier_runs_snapshots_and_figures(tmp_path):
+    """A run without snapshots leaves none of an earlier run's in its folder (`beltsim
+    animate --from DIR` would draw them as this run's), nor the figures drawn from it;
+    a file of the user's own stays."""
     from helpers import cli
 
     small = ("run", "paper_quasistatic", "--set", "numerics.elements=60", "--quiet",
@@ -65,7 +66,12 @@ def test_run_clears_an_earlier_runs_snapshots_it_did_not_write(tmp_path):
     proc = cli(*small, "--snapshots", "0.05", timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "snapshots.npz").is_file()
+    proc = cli("plot", tmp_path, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "fields.png").is_file() and (tmp_path / "history.png").is_file()
+    (tmp_path / "transient.gif").write_bytes(b"an earlier run's animation")
+    (tmp_path / "notes.txt").write_text("mine")
     proc = cli(*small, timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert {p.name for p in tmp_path.iterdir()} == {
-        "summary.json", "fields.csv", "history.csv", "scene.toml"}
+        "summary.json", "fields.csv", "history.csv", "scene.toml", "notes.txt"}

@@ -64,6 +64,9 @@ def _progress(args) -> bool:
 
 #: What 'beltsim analytic' writes: both for a straight belt, the summary for a drive
 ANALYTIC_FILES = ("summary.json", "fields.csv")
+#: What 'beltsim plot DIR' and 'beltsim animate --from DIR' draw from a run into its folder:
+#: a new run there removes them (they are the earlier run's)
+RUN_FIGURES = ("fields.png", "history.png", "drive.png", "transient.gif", "transient.mp4")
 #: The figures of 'beltsim sweep', each for one key: a sweep removes the one it does not draw
 SWEEP_FIGURES = ("creep_collapse.png", "characteristic.png")
 
@@ -135,8 +138,8 @@ def cmd_run(args):
         return 130
     result.reference = sim.readout.reference()
     written = save_run(result, out)
-    # an earlier run's snapshots would animate as this run's
-    _clear_stale(out, (SNAPSHOTS,), written=[p.name for p in written])
+    # an earlier run's snapshots would animate as this run's, its figures show as this one's
+    _clear_stale(out, (SNAPSHOTS, *RUN_FIGURES), written=[p.name for p in written])
     summary = result.summary()
     print(format_summary(summary, title=title))
     print(format_run(summary))
