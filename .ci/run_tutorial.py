@@ -148,7 +148,12 @@ def main(argv=None) -> int:
     for cell in nb.cells:
         if cell.cell_type == "code" and cell.source.strip():
             first = cell.source.splitlines()[0]
-            at = next(i for i in range(at, len(lines)) if lines[i] == first)
+            at = next((i for i in range(at, len(lines)) if lines[i].rstrip() == first.rstrip()),
+                      None)
+            if at is None:  # jupytext changed the cell: its lines cannot be numbered
+                print(f"tutorial notebook: FAILED: a cell starting {first!r} is not a block "
+                      f"of the page", file=sys.stderr)
+                return 1
             cell.source = checked(cell.source, at + 1)
             at += len(cell.source.splitlines())
     helpers = "\n\n".join(inspect.getsource(f) for f in (ellipsis_match, _shown))
