@@ -75,3 +75,22 @@ def test_run_clears_an_earlier_runs_snapshots_and_figures(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert {p.name for p in tmp_path.iterdir()} == {
         "summary.json", "fields.csv", "history.csv", "scene.toml", "notes.txt"}
+
+
+@pytest.mark.unit
+def test_animate_of_a_scene_clears_an_earlier_runs_figures(tmp_path, monkeypatch):
+    """`beltsim animate SCENE` runs the scene again: the figures of the folder's earlier
+    run go, the other format's animation among them (the encoder is stubbed here)."""
+    from beltsim.plots import animate as animate_module
+
+    def encode(snapshots, path, fmt, fps):
+        path.write_bytes(b"frames")
+        return path
+    monkeypatch.setattr(animate_module, "animate", encode)
+    for name in ("transient.mp4", "fields.png", "notes.txt"):
+        (tmp_path / name).write_bytes(b"earlier")
+    assert cli_module.main(["animate", "paper_quasistatic", "--set", "numerics.elements=60",
+                            "--format", "gif", "--quiet", "--out", str(tmp_path)]) == 0
+    names = {p.name for p in tmp_path.iterdir()}
+    assert {"transient.gif", "snapshots.npz", "notes.txt"} <= names
+    assert not names & {"transient.mp4", "fields.png"}

@@ -396,6 +396,9 @@ def cmd_animate(args):
         result = run(scene, progress=_progress(args), raise_on_failure=False,
                      snapshot_interval=interval)
         save_run(result, out)
+        # a new run: the figures of an earlier one, the other format's animation among
+        # them, go
+        _clear_stale(out, RUN_FIGURES, written=(f"transient.{args.format}",))
         print(f"ran {args.scene}: {'steady' if result.converged else result.reason} at "
               f"t = {result.simulated_time:.4g} s, {len(result.snapshots['t'])} snapshots")
         src = out
