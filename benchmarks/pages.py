@@ -94,6 +94,9 @@ def _ours_table(page: Page, res: dict, compile_s: float, load_s: float) -> None:
         ["compile the default scheme's kernels, empty cache [s]",
          fmt(compile_s, ".3g") if compile_s is not None else "not measured"],
         ["load them from numba's cache [s]", fmt(load_s, ".3g")],
+        ["`import beltsim` in a fresh interpreter [s]", fmt(res["import_time"], ".3g")],
+        [("warm run: `beltsim run` in a fresh process with the kernels cached, to steady "
+          "state, end to end [s]"), fmt(res["warm_run_time"], ".3g")],
         [("cold start: `beltsim run` in a fresh process with an empty cache, to steady "
           "state [s]"), fmt(res["cold_start_time"], ".3g") if res["cold_start_time"] is not None
          else "not measured"]])
@@ -187,7 +190,8 @@ def build(page: Page, quick: bool, cold: bool = True) -> None:
     el = f" --elements {elements}" if elements else ""
     page.para(f"`beltsim bench{el} --repeat {repeat}{'' if cold else ' --no-cold'}`: the "
               f"default run from rest to steady state, the steady scheme, the explicit "
-              f"kernel alone in a settled state, and a cold start.")
+              f"kernel alone in a settled state, the import, a warm run end to end and a "
+              f"cold start.")
     compile_s = kernel_load_time(scene, empty_cache=True) if cold else None
     load_s = kernel_load_time(scene, empty_cache=False)
     res = ours_bench.bench(scene, cold=cold, repeat=repeat, log=log)

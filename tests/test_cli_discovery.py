@@ -52,3 +52,45 @@ def test_analytic_writes_a_folder_of_its_own_scene_and_clears_what_it_did_not_wr
     assert proc.returncode == 0, proc.stderr
     assert {p.name for p in own.iterdir()} == {"summary.json"}
     assert "slip_arc_driver" in (own / "summary.json").read_text()
+
+
+@pytest.mark.cli
+def test_run_clears_an_earlier_runs_snapshots_and_figures(tmp_path):
+    """A run without snapshots leaves none of an earlier run's in its folder (`beltsim
+    animate --from DIR` would draw them as this run's), nor the figures drawn from it;
+    a file of the user's own stays."""
+    from helpers import cli
+
+    small = ("run", "paper_quasistatic", "--set", "numerics.elements=60", "--quiet",
+             "--out", tmp_path)
+    proc = cli(*small, "--snapshots", "0.05", timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "snapshots.npz").is_file()
+    proc = cli("plot", tmp_path, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "fields.png").is_file() and (tmp_path / "history.png").is_file()
+    (tmp_path / "transient.gif").write_bytes(b"an earlier run's animation")
+    (tmp_path / "notes.txt").write_text("mine")
+    proc = cli(*small, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert {p.name for p in tmp_path.iterdir()} == {
+        "summary.json", "fields.csv", "history.csv", "scene.toml", "notes.txt"}
+
+
+@pytest.mark.unit
+def test_animate_of_a_scene_clears_an_earlier_runs_figures(tmp_path, monkeypatch):
+    """`beltsim animate SCENE` runs the scene again: the figures of the folder's earlier
+    run go, the other format's animation among them (the encoder is stubbed here)."""
+    from beltsim.plots import animate as animate_module
+
+    def encode(snapshots, path, fmt, fps):
+        path.write_bytes(b"frames")
+        return path
+    monkeypatch.setattr(animate_module, "animate", encode)
+    for name in ("transient.mp4", "fields.png", "notes.txt"):
+        (tmp_path / name).write_bytes(b"earlier")
+    assert cli_module.main(["animate", "paper_quasistatic", "--set", "numerics.elements=60",
+                            "--format", "gif", "--quiet", "--out", str(tmp_path)]) == 0
+    names = {p.name for p in tmp_path.iterdir()}
+    assert {"transient.gif", "snapshots.npz", "notes.txt"} <= names
+    assert not names & {"transient.mp4", "fields.png"}

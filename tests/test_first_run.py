@@ -24,6 +24,17 @@ def test_import_beltsim_leaves_numba_scipy_and_matplotlib_for_later():
     assert json.loads(proc.stdout) == []
 
 
+def test_the_exact_solution_of_a_stick_scene_leaves_scipy_optimize_for_the_slip_front():
+    """`beltsim analytic` of a perfect-adhesion scene, and beltsim.solve of one, do not
+    wait for scipy.optimize (0.3-0.5 s to import): only a slip front's root needs it."""
+    code = ("import sys, beltsim; beltsim.solve(beltsim.paper_scene('{}')); "
+            "print('scipy.optimize' in sys.modules)")
+    for scene, wanted in (("quasistatic", "False"), ("slip", "True")):
+        proc = subprocess.run([sys.executable, "-c", code.format(scene)], capture_output=True,
+                              text=True, timeout=120, check=True)
+        assert proc.stdout.strip() == wanted, scene
+
+
 def test_the_lazy_names_and_subpackages_resolve():
     assert set(beltsim.__all__) <= set(dir(beltsim))
     for name in beltsim.__all__:

@@ -76,6 +76,8 @@ def test_quick_performance_page(tmp_path):
     assert "Machine: " in text and "numba " in text and "cores" in text
     for method in ("Radau", "BDF", "ported to numpy", "Newton"):
         assert method in text, method
+    # what a user waits for, beside the solve
+    assert "`import beltsim` in a fresh interpreter" in text and "warm run: `beltsim run`" in text
 
 
 @pytest.fixture

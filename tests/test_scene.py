@@ -226,3 +226,20 @@ def test_the_cli_runs_a_shipped_scene_by_name(tmp_path):
                "--out", tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "summary.json").is_file() and "converged       true" in proc.stdout
+
+
+def test_a_drive_title_that_sizes_its_pulleys_says_radius_and_matches_the_file():
+    """A pulley's size in a shipped drive's title reads as its radius (an engineer reads
+    a bare "80 mm pulley" as a diameter), and the numbers are the scene's own."""
+    import re
+
+    import beltsim
+    for name in beltsim.scene_names():
+        data = beltsim.load_scene(name).to_dict()
+        title = data.get("title", "")
+        sizes = re.search(r"(\d+(?:\.\d+)?) / (\d+(?:\.\d+)?) mm", title)
+        if "drive" not in data or sizes is None:
+            continue
+        assert re.search(r"radi(us|i) " + re.escape(sizes.group(0)), title), title
+        radii = (data["drive"]["driver_radius"], data["drive"]["driven_radius"])
+        assert tuple(float(s) / 1000 for s in sizes.groups()) == pytest.approx(radii), title

@@ -106,6 +106,8 @@ def test_bench_command_prints_json_last():
     assert last["elements"] == 20 and last["ours_converged"] is True
     assert last["ours_wall_time"] > 0 and last["ours_steady_wall_time"] > 0
     assert last["explicit_node_steps_per_s"] > 0 and last["cold_start_time"] is None
+    # what a user waits for, each in a fresh process: the import is part of the run
+    assert 0 < last["import_time"] < last["warm_run_time"]
     # 20 elements, second order: total friction measured 7.8e-3 (both schemes)
     assert last["ours_error"] < ERROR_FACTOR * 7.8e-3
     assert last["ours_steady_error"] < ERROR_FACTOR * 7.8e-3

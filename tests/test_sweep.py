@@ -65,6 +65,8 @@ def test_parse_vary_validates():
 
 @pytest.mark.cli
 def test_sweep_command_writes_csv_and_figure(tmp_path):
+    # a drive's load sweep drew this here before: it is not this sweep's, so it goes
+    (tmp_path / "characteristic.png").write_bytes(b"an earlier sweep's figure")
     proc = subprocess.run(
         [sys.executable, "-m", "beltsim.cli", "sweep", scene_path("paper_slip"), "--vary",
          "contact.max_friction=5e4,1e5,1e6", "--set", "numerics.elements=300", "--workers",
@@ -77,6 +79,7 @@ def test_sweep_command_writes_csv_and_figure(tmp_path):
         for k in ("total_friction", "stick_friction", "slip_friction", "slip_start"):
             assert np.isfinite(float(r[k])) and np.isfinite(float(r[f"{k}_analytic"]))
     assert (tmp_path / "creep_collapse.png").stat().st_size > 20_000
+    assert not (tmp_path / "characteristic.png").exists()
 
 
 @pytest.mark.unit

@@ -64,6 +64,11 @@ def _progress(args) -> bool:
 
 #: What 'beltsim analytic' writes: both for a straight belt, the summary for a drive
 ANALYTIC_FILES = ("summary.json", "fields.csv")
+#: What 'beltsim plot DIR' and 'beltsim animate --from DIR' draw from a run into its folder:
+#: a new run there removes them (they are the earlier run's)
+RUN_FIGURES = ("fields.png", "history.png", "drive.png", "transient.gif", "transient.mp4")
+#: The figures of 'beltsim sweep', each for one key: a sweep removes the one it does not draw
+SWEEP_FIGURES = ("creep_collapse.png", "characteristic.png")
 
 
 def _analytic_outdir(args):
@@ -104,7 +109,7 @@ def cmd_run(args):
     from pathlib import Path
 
     from .io.files import prepare_outdir
-    from .io.results import CHECKPOINT, save_run
+    from .io.results import CHECKPOINT, SNAPSHOTS, save_run
     from .simulation.controller import Simulation
 
     if args.snapshots is not None and not args.snapshots > 0:
@@ -132,7 +137,9 @@ def cmd_run(args):
               f"'beltsim run --resume {out}'", file=sys.stderr)
         return 130
     result.reference = sim.readout.reference()
-    save_run(result, out)
+    written = save_run(result, out)
+    # an earlier run's snapshots would animate as this run's, its figures show as this one's
+    _clear_stale(out, (SNAPSHOTS, *RUN_FIGURES), written=[p.name for p in written])
     summary = result.summary()
     print(format_summary(summary, title=title))
     print(format_run(summary))
@@ -263,6 +270,7 @@ def cmd_sweep(args):
     data = [[np.nan if v is None else v for v in col] for col in data]
     write_csv(out / "sweep.csv", cols, data)
     print(f"wrote {out / 'sweep.csv'}")
+    _clear_stale(out, SWEEP_FIGURES, written=("creep_collapse.png",) if collapse else ())
     if collapse:
         save_figure(creep_collapse, out / "creep_collapse.png", rows, title=scene.title,
                     dpi=CREEP_COLLAPSE_DPI)
@@ -295,7 +303,9 @@ def _drive_sweep(args, scene, key, values):
         [np.nan if r[c] is None else r[c] for r in rows] for c in cols[2:]]
     write_csv(out / "sweep.csv", cols, data, text_columns=("status",))
     print(f"wrote {out / 'sweep.csv'}")
-    if key == "drive.load_torque":
+    characteristic = key == "drive.load_torque"
+    _clear_stale(out, SWEEP_FIGURES, written=("characteristic.png",) if characteristic else ())
+    if characteristic:
         ok = [r for r in rows if r["converged"]]
         fig = save_figure(
             plot_characteristic, out / "characteristic.png",
@@ -386,6 +396,9 @@ def cmd_animate(args):
         result = run(scene, progress=_progress(args), raise_on_failure=False,
                      snapshot_interval=interval)
         save_run(result, out)
+        # a new run: the figures of an earlier one, the other format's animation among
+        # them, go
+        _clear_stale(out, RUN_FIGURES, written=(f"transient.{args.format}",))
         print(f"ran {args.scene}: {'steady' if result.converged else result.reason} at "
               f"t = {result.simulated_time:.4g} s, {len(result.snapshots['t'])} snapshots")
         src = out
@@ -520,7 +533,8 @@ def build_parser():
     p.set_defaults(func=cmd_stability)
 
     p = sub.add_parser("bench", help="wall times of the default and steady runs, the explicit "
-                       "kernel's speed and a cold start (peers: benchmarks/ of the repository)")
+                       "kernel's speed, import beltsim, a warm run end to end and a cold start "
+                       "(peers: benchmarks/ of the repository)")
     _add_scene_args(p, nargs="?", default="paper_slip",
                     help="scene file or shipped scene name (default paper_slip)")
     p.add_argument("--elements", type=int, default=None,

@@ -1,5 +1,6 @@
 """The benchmark of a scene: the default and steady runs' wall times, the explicit kernel's
-speed and a cold start.
+speed, and what a user waits for: ``import beltsim``, a run end to end in a fresh process
+with the kernels cached, and a cold start.
 
 Every wall time is the shortest of ``repeat`` runs and excludes numba compilation, which
 is reported apart. The comparison with generic scipy peers and with a numpy port of the
@@ -35,11 +36,10 @@ def explicit_node_steps_per_s(scene: Scene, settle=0.05, span=0.02) -> float:
     return (sim.steps - steps0) * (sim.grid.n_elements - 1) / wall
 
 
-def cold_start_time(scene: Scene) -> float:
-    """Wall time of ``beltsim run`` in a fresh process with an empty numba cache, from
-    start to steady state (the scene written to a file first)."""
-    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as out:
-        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+def _cli_run_time(scene: Scene, env: dict, what: str) -> float:
+    """Wall time of ``beltsim run`` of ``scene`` in a fresh process, from start to steady
+    state (the scene written to a file first)."""
+    with tempfile.TemporaryDirectory() as out:
         path = os.path.join(out, "scene.toml")
         with open(path, "w", encoding="utf-8") as fh:
             fh.write(scene.to_toml())
@@ -49,8 +49,34 @@ def cold_start_time(scene: Scene) -> float:
         proc = subprocess.run(cmd, env=env, capture_output=True, text=True)
         wall = time.perf_counter() - start
         if proc.returncode != 0:
-            raise RuntimeError(f"cold-start run failed: {proc.stderr.strip()}")
+            raise RuntimeError(f"{what} run failed: {proc.stderr.strip()}")
     return wall
+
+
+def cold_start_time(scene: Scene) -> float:
+    """Wall time of ``beltsim run`` in a fresh process with an empty numba cache, from
+    start to steady state (the scene written to a file first)."""
+    with tempfile.TemporaryDirectory() as cache:
+        return _cli_run_time(scene, dict(os.environ, NUMBA_CACHE_DIR=cache), "cold-start")
+
+
+def warm_run_time(scene: Scene, repeat=3) -> float:
+    """Wall time of ``beltsim run`` end to end in a fresh process whose kernels are in
+    numba's cache (this process's runs put them there), the shortest of ``repeat``."""
+    return min(_cli_run_time(scene, dict(os.environ), "warm") for _ in range(repeat))
+
+
+def import_time(repeat=3) -> float:
+    """Seconds of ``import beltsim`` in a fresh interpreter, the shortest of ``repeat``."""
+    code = ("import time; start = time.perf_counter(); import beltsim; "
+            "print(time.perf_counter() - start)")
+    times = []
+    for _ in range(repeat):
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"import beltsim failed: {proc.stderr.strip()}")
+        times.append(float(proc.stdout))
+    return min(times)
 
 
 def best_of(runs):
@@ -94,19 +120,27 @@ def run_ours(scene: Scene, repeat=3, log=print) -> tuple[dict, object, object]:
 
 
 def bench(scene: Scene, cold=True, repeat=3, log=print) -> dict:
-    """The default run, the steady scheme, the explicit kernel's speed and a cold start,
-    of a straight belt or a drive.
+    """The default run, the steady scheme, the explicit kernel's speed, the import, a
+    warm run end to end and a cold start, of a straight belt or a drive.
 
     Keys: ``elements``, ``figure`` (what the errors are of: the total friction, a drive's
     tight span tension), ``ours_*`` (the scene's scheme, the default run), ``ours_steady_*``
-    (the steady scheme), ``explicit_node_steps_per_s`` and ``cold_start_time`` (a fresh
-    process with an empty numba cache, run to steady state; None when ``cold`` is false).
+    (the steady scheme), ``explicit_node_steps_per_s``, ``import_time`` (``import
+    beltsim`` in a fresh interpreter), ``warm_run_time`` (``beltsim run`` in a fresh
+    process with the kernels cached, start to steady state, files included) and
+    ``cold_start_time`` (the same with an empty numba cache; None when ``cold`` is false).
+    The last three are each the shortest of ``repeat``, but the cold start: one.
     """
     out, _, _ = run_ours(scene, repeat, log)
     out["explicit_node_steps_per_s"] = (explicit_node_steps_per_s(scene)
                                         if scene.params.inertia else None)
     if out["explicit_node_steps_per_s"] is not None:
         log(f"explicit kernel: {out['explicit_node_steps_per_s']:.3g} node-steps/s")
+    out["import_time"] = import_time(repeat)
+    log(f"import beltsim (fresh interpreter): {out['import_time']:.3f} s")
+    out["warm_run_time"] = warm_run_time(scene, repeat)
+    log(f"warm run (fresh process, kernels cached, to steady state, end to end): "
+        f"{out['warm_run_time']:.2f} s")
     out["cold_start_time"] = None
     if cold:
         out["cold_start_time"] = cold_start_time(scene)
