@@ -36,10 +36,9 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import NoSolutionError, SceneError
-from .analytic import GrossSlipError, LiftOffError
+from .analytic import GrossSlipError, LiftOffError, brentq
 from .figures import hub_loads, layout_summary
 from .geometry import GeometryError
 from .pulleys import PulleyLayout

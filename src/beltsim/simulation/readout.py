@@ -109,9 +109,12 @@ class LoopReadout(Readout):
         else:
             # the first free pulley's speed second, over the driver's speed ratio
             first = next(p for p in P.pulleys if p.role != "driver")
-            spans = [k for k in figure_keys(P.layout.names) if k.startswith("tension[")]
-            self.periodic_keys = ("driver_torque", f"speed[{first.name}]", "belt_speed",
-                                  *spans)
+            # the first free pulley's speed is compared between periods; every span's
+            # tension and every pulley's speed is reported over the last one
+            keys = figure_keys(P.layout.names)
+            speeds = [f"speed[{p.name}]" for p in P.pulleys if p.role != "driver"]
+            self.periodic_keys = ("driver_torque", *speeds, "belt_speed",
+                                  *(k for k in keys if k.startswith("tension[")))
             self.second_scale = P.driver_rim_speed / first.radius
         #: each global's speed scale: the rim speed, and its radius for a pulley's
         radii = np.array([1.0] + [p.radius for p in P.pulleys if p.role != "driver"])
@@ -139,19 +142,32 @@ class LoopReadout(Readout):
                          np.max(np.abs(state.ud)) / creep) * self.disc.window)
 
     def outcome(self, sim):
-        """Lift-off, or gross slip: a whole wrap slides while the driven pulley slows,
-        GROSS_SLIP_CHECKS checks in a row."""
+        """Lift-off, or gross slip: a whole wrap slides while a pulley slows,
+        GROSS_SLIP_CHECKS checks in a row; under a periodic drive, after its ramp, a whole
+        wrap that slides at every check of two whole periods (a wrap that slides for part
+        of each period is the periodic state's, not an end)."""
         sol = sim.solution()
         why = sol.lift_off()
         if why is not None:
             return RunStatus.LIFT_OFF, f"t = {sim.t:.6g} s: {why}"
         which = sol.sliding_arc()
-        self._sliding = (self._sliding + 1 if which and np.any(sim.state.gd[1:] < 0)
-                         else 0)
-        if self._sliding >= GROSS_SLIP_CHECKS:
+        samples = getattr(sim.steady, "samples", None)
+        if samples is None:
+            slowing = np.any(sim.state.gd[1:] < 0)
+            self._sliding = self._sliding + 1 if which and slowing else 0
+            if self._sliding >= GROSS_SLIP_CHECKS:
+                return RunStatus.GROSS_SLIP, (
+                    f"t = {sim.t:.6g} s: gross slip at {which}: the belt slides over its "
+                    f"whole wrap and a pulley slows down")
+            return None
+        # a periodic drive's speeds rise and fall each period, and its start-up may slide
+        # for a while: after the ramp, a whole wrap sliding through two whole periods
+        on = which is not None and sim.t >= sim.steady.t_min
+        self._sliding = self._sliding + 1 if on else 0
+        if self._sliding >= 2 * samples:
             return RunStatus.GROSS_SLIP, (
                 f"t = {sim.t:.6g} s: gross slip at {which}: the belt slides over its "
-                f"whole wrap and a pulley slows down")
+                f"whole wrap through two whole periods of the drive")
         return None
 
     @staticmethod

@@ -299,13 +299,15 @@ class PeriodicTracker(Tracker):
         return Stop(RunStatus.CONVERGED) if self._count >= self.hold else None
 
     def last_period(self) -> dict | None:
-        """Minimum, maximum and mean over the last period of the quantities in ``keys``."""
+        """Minimum, maximum, mean and amplitude (half the range) over the last period of
+        the quantities in ``keys``."""
         if len(self._rows) < self.samples:
             return None
         rows = np.array(self._rows)[-self.samples:]
         out = {"period": self.period, "change": float(self.change)}
         for col, key in enumerate(self.keys, 1):
-            out[key] = {"min": float(rows[:, col].min()), "max": float(rows[:, col].max()),
+            lo, hi = float(rows[:, col].min()), float(rows[:, col].max())
+            out[key] = {"min": lo, "max": hi, "amplitude": 0.5 * (hi - lo),
                         "mean": float(rows[:, col].mean())}  # equal phases: exact for a sine
         return out
 
