@@ -17,11 +17,12 @@ the one discrete model (:mod:`beltsim.physics.layout`, :mod:`beltsim.solvers`).
 """
 
 from .analytic import GrossSlipError, LiftOffError, StringSolution, capacity, solve_string
-from .creep import SerpentineData, SerpentineSolution, Tensioner, solve_serpentine
+from .creep import SerpentineData, SerpentineSolution, solve_serpentine
 from .exact import exact_state, string_state
 from .geometry import Geometry
 from .pulleys import Pulley, PulleyLayout
 from .scene import DriveParams, DriveScene
+from .tensioner import Tensioner
 
 __all__ = ["DriveParams", "DriveScene", "Geometry", "GrossSlipError", "LiftOffError",
            "Pulley", "PulleyLayout", "SerpentineData", "SerpentineSolution",

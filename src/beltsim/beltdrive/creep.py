@@ -40,23 +40,8 @@ import numpy as np
 from ..errors import NoSolutionError, SceneError
 from .analytic import GrossSlipError, LiftOffError, brentq
 from .figures import hub_loads, layout_summary
-from .geometry import GeometryError
 from .pulleys import PulleyLayout
-
-
-@dataclass(frozen=True)
-class Tensioner:
-    """An idler on a spring-loaded arm about a fixed pivot.
-
-    ``index`` the idler's pulley, ``pivot`` O (m), ``stiffness`` k_t (N m/rad),
-    ``preload`` tau0 (N m): the spring's torque with the arm as drawn, in the sense that
-    turns the pulley into the belt (the sense in which the loop length grows).
-    """
-
-    index: int
-    pivot: tuple[float, float]
-    stiffness: float
-    preload: float
+from .tensioner import Tensioner, equilibrium
 
 
 @dataclass(frozen=True)
@@ -295,7 +280,7 @@ class SerpentineSolution:
 
         The resultant of this model's contact forces (pressure (N - rho c^2) / r,
         friction -kappa N') differs from it by (rho c^2 / b1) times the integral of
-        N' tau over the arc, below rho c^2 |T_out - T_in| / b1: the pressure leaves the
+        N' tau over the arc, below ``rho c^2 |T_out - T_in| / b1``: the pressure leaves the
         momentum flux's share rho c^2 N / b1 out (a momentum-exact pressure
         (kappa N - rho c^2) / r would give kappa T - rho c^2 in place of T - rho c^2)."""
         return hub_loads(self.layout, self.data.rho, self.c, self.tensions)
@@ -419,8 +404,8 @@ class SerpentineSolution:
                                 slip_margin=self.slip_margins,
                                 slip_power=self.slip_powers)}
         if self.alpha is not None:
-            out["tensioner"] = {"name": self.layout.names[self.data.tensioner.index],
-                                "alpha": self.alpha, "offset": self.alpha_offset}
+            out.update(arm_angle=self.alpha,
+                       arm_travel=self.sense_tensioner * self.alpha_offset)
         return out
 
 
@@ -446,95 +431,13 @@ def _solve_layout(d: SerpentineData, layout: PulleyLayout) -> SerpentineSolution
     return SerpentineSolution(d, layout, c, T, phi)
 
 
-def tensioner_sense(layout: PulleyLayout, k: int, pivot) -> int:
-    """The sense in which turning pulley k's arm lengthens the loop.
-
-    dLambda / dP_k = t_in - t_out (a span's length changes by its end's motion along it;
-    the wraps' change is of second order) and dP_k / dalpha = J (P_k - O).
-
-    Parameters
-    ----------
-    layout : PulleyLayout
-    k : int
-        The tensioner pulley's index.
-    pivot : (float, float)
-        The arm's pivot O (m).
-
-    Returns
-    -------
-    int
-        +1 when turning the arm counterclockwise lengthens the loop, else -1.
-    """
-    t = layout.span_directions
-    arm = layout.centres[k] - np.asarray(pivot, dtype=float)
-    grad = t[k - 1] - t[k]
-    return 1 if float(np.dot(grad, [-arm[1], arm[0]])) > 0 else -1
-
-
 def _solve_tensioner(d: SerpentineData) -> SerpentineSolution:
     ten = d.tensioner
-    k, O = ten.index, np.asarray(ten.pivot, dtype=float)
-    arm = d.layout.centres[k] - O
-    a = float(np.hypot(*arm))
-    a0 = math.atan2(arm[1], arm[0])
-    s = tensioner_sense(d.layout, k, O)
-
-    def at(beta):  # the solution with the arm turned by beta into the belt, or the error
-        alpha = a0 + s * beta
-        try:
-            lay = d.layout.moved(k, O + a * np.array([math.cos(alpha), math.sin(alpha)]))
-            return _solve_layout(d, lay)
-        except (GeometryError, NoSolutionError) as exc:
-            return exc
-
-    def h(sol, beta):  # the net torque on the arm in the sense s
-        F = sol.hub_loads[k]
-        P = sol.layout.centres[k] - O
-        return ten.preload - ten.stiffness * beta + s * (P[0] * F[1] - P[1] * F[0])
-
-    first = at(0.0)
-    if isinstance(first, Exception):
-        raise NoSolutionError(f"tensioner: no equilibrium: the drawn layout has no steady "
-                              f"state ({first})")
-    f0 = h(first, 0.0)
-    if f0 == 0:
-        return _with_arm(first, a0, a0, s)
-    step = 1e-3 if f0 > 0 else -1e-3
-    b_ok, b_try = 0.0, step
-    reason = None
-    while abs(b_try) <= math.pi:
-        sol = at(b_try)
-        if isinstance(sol, Exception):
-            reason = sol
-            fails = b_try
-            for _ in range(60):  # close in on the last valid angle before the failure
-                mid = 0.5 * (b_ok + fails)
-                sm = at(mid)
-                if isinstance(sm, Exception):
-                    fails = mid
-                    continue
-                fm = h(sm, mid)
-                if fm * f0 <= 0:
-                    b_try, sol = mid, sm
-                    break
-                b_ok = mid
-            if isinstance(sol, Exception):
-                break
-        f = h(sol, b_try)
-        if f * f0 <= 0:
-            beta = brentq(lambda b: h(at(b), b), b_ok, b_try, xtol=1e-14, rtol=1e-14)
-            return _with_arm(at(beta), a0 + s * beta, a0, s)
-        b_ok, b_try = b_try, 2.0 * b_try
-    where = "the spring" if f0 > 0 else "the belt"
-    raise NoSolutionError(
-        f"tensioner: no equilibrium of pulley {d.layout.names[k]!r}'s arm: {where} wins "
-        f"up to {math.degrees(b_ok):.4g} deg from the drawn angle"
-        + (f", where {reason}" if reason is not None else ""))
-
-
-def _with_arm(sol, alpha, alpha0, s):
+    beta, sol = equilibrium(ten, d.layout, lambda b: _solve_layout(d, ten.turned(d.layout, b)),
+                            lambda sol: sol.hub_loads[ten.index])
+    _, alpha0, s = ten.arm(d.layout)
     return SerpentineSolution(sol.data, sol.layout, sol.c, sol.tensions, sol.phi_s,
-                              alpha, alpha0, s)
+                              alpha0 + s * beta, alpha0, s)
 
 
 def solve_serpentine(data: SerpentineData) -> SerpentineSolution:
@@ -567,4 +470,4 @@ def solve_serpentine(data: SerpentineData) -> SerpentineSolution:
 
 
 __all__ = ["GrossSlipError", "LiftOffError", "SerpentineData", "SerpentineSolution",
-           "Tensioner", "solve_serpentine", "tensioner_sense"]
+           "Tensioner", "solve_serpentine"]

@@ -13,11 +13,15 @@ from .params import DriveParams
 
 
 def serpentine_data(P: DriveParams) -> SerpentineData:
-    """The creep theory's data of a drive (its final speeds and loads)."""
+    """The creep theory's data of a drive (its final speeds and loads; the layout as
+    drawn, with a tensioner's arm at its drawn angle)."""
+    if P.tensioner is not None and P.arm_turn:
+        P = P.at_arm(-P.arm_turn)
     return SerpentineData(layout=P.layout, b1=P.b1, rho=P.rho,
                           mu=None if P.mu is None else P.mus, N0=P.N0,
                           driver=P.driver, omega=P.omega1,
-                          loads=tuple(p.final_load for p in P.pulleys))
+                          loads=tuple(p.final_load for p in P.pulleys),
+                          tensioner=P.tensioner)
 
 
 def string_state(P: DriveParams):
@@ -28,7 +32,9 @@ def string_state(P: DriveParams):
     NoSolutionError
         The drive has no steady state (gross slip, lift-off).
     """
-    return solve_string(P) if P.two_pulley else solve_serpentine(serpentine_data(P))
+    if P.two_pulley and P.tensioner is None:
+        return solve_string(P)
+    return solve_serpentine(serpentine_data(P))
 
 
 def exact_state(P: DriveParams):

@@ -15,11 +15,12 @@ SNAPSHOTS = "snapshots.npz"
 
 def format_drive(summary: dict, title: str = "") -> str:
     """A short table of a drive's figures: a two-pulley drive's by name, and on more
-    pulleys each span's tension and each pulley's speed, slip arc, torque and hub load."""
+    pulleys each span's tension and each pulley's speed, slip arc, torque and hub load
+    (and a tensioner's arm angle and travel)."""
     units = {"tight_tension": "N", "slack_tension": "N", "belt_speed": "m/s",
              "driven_speed": "rad/s", "speed_ratio": "", "slip_arc_driver": "rad",
              "slip_arc_driven": "rad", "driver_torque": "N m", "efficiency": "",
-             "slip_power": "W"}
+             "slip_power": "W", "arm_angle": "rad", "arm_travel": "rad"}
     width = max(len(k) for k in units)
     lines = [title] if title else []
     for k, unit in units.items():

@@ -9,12 +9,13 @@ data: both import them from here, so neither imports the other's importer.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..problem.rules import derived_stiffness, final_value
 from .geometry import Geometry
 from .pulley_tables import PulleySpec, driver_index, installation_tension, specs_of
 from .pulleys import Pulley, PulleyLayout
+from .tensioner import Tensioner, installation_tension_at, tensioner_of
 
 
 @dataclass(frozen=True)
@@ -23,7 +24,10 @@ class DriveParams:
 
     ``rho`` and ``I`` are zero for a quasistatic scene; ``mu`` is None for perfect
     adhesion ("stick"); ``lever`` is h / 2 for the beam and 0 for the string.
-    ``pulleys`` are in the belt's order and ``layout`` is their geometry.
+    ``pulleys`` are in the belt's order and ``layout`` is their geometry. ``tensioner``
+    is the arm of one idler (None without one); ``arm_turn`` is how far that arm is
+    turned into the belt from its drawn angle (rad) in ``layout`` and ``pulleys``, whose
+    belt is the one installed at N0 on the layout as drawn (:meth:`at_arm`).
     """
 
     h: float
@@ -40,6 +44,37 @@ class DriveParams:
     N0: float
     pulleys: tuple[PulleySpec, ...]
     layout: PulleyLayout
+    tensioner: Tensioner | None = None
+    arm_turn: float = 0.0
+
+    def at_arm(self, beta: float) -> DriveParams:
+        """The same drive with the tensioner's arm turned by a further ``beta`` (rad)
+        into the belt: the pulley moved, the same belt (its N0 on the turned layout)."""
+        ten = self.tensioner
+        layout = ten.turned(self.layout, beta)
+        pulleys = list(self.pulleys)
+        pulleys[ten.index] = replace(pulleys[ten.index],
+                                     centre=tuple(map(float, layout.centres[ten.index])))
+        return replace(self, layout=layout, pulleys=tuple(pulleys),
+                       N0=installation_tension_at(self.N0, self.b1, self.layout.loop_length,
+                                                  layout.loop_length),
+                       arm_turn=self.arm_turn + beta)
+
+    @property
+    def roles(self) -> tuple[str, ...]:
+        """Each pulley's role: "driver", "driven", "tensioner" or "idler"."""
+        ten = self.tensioner
+        return tuple("tensioner" if ten is not None and i == ten.index else p.role
+                     for i, p in enumerate(self.pulleys))
+
+    def arm_figures(self) -> dict:
+        """``arm_angle`` (rad, counterclockwise from +x about the pivot) and
+        ``arm_travel`` (rad, into the belt from the drawn angle) of the tensioner's arm;
+        empty without one."""
+        if self.tensioner is None:
+            return {}
+        return {"arm_angle": self.tensioner.arm(self.layout)[1],
+                "arm_travel": self.arm_turn}
 
     @property
     def lever(self) -> float:
@@ -113,7 +148,8 @@ def params_of(d: dict) -> DriveParams:
         model=physics.get("model", "beam"), friction=contact["friction"],
         mu=contact.get("friction_coefficient"),
         N0=installation_tension(d["drive"], layout.loop_length, stiff["b1"]),
-        pulleys=specs, layout=layout)
+        pulleys=specs, layout=layout,
+        tensioner=tensioner_of(d.get("tensioner"), [p.name for p in specs]))
 
 
 def layout_of(specs) -> PulleyLayout:

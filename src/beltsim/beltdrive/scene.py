@@ -11,6 +11,8 @@ A scene with a ``[drive]`` section is a closed drive. Its sections:
 * ``[physics]``: ``inertia``, ``damping`` and ``model`` ("beam": the shear-deformable
   beam; "string": the extensible string, whose friction has no lever about the middle
   line);
+* ``[tensioner]`` (optional): an idler on a spring-loaded arm
+  (:mod:`beltsim.beltdrive.tensioner`);
 * ``[numerics]``: how the problem is solved, never which problem.
 
 Validation happens in :func:`validate`; every rule raises a one-line
@@ -19,7 +21,9 @@ Validation happens in :func:`validate`; every rule raises a one-line
 
 from __future__ import annotations
 
+import copy
 import math
+from dataclasses import replace
 
 from ..errors import NoSolutionError, SceneError
 from ..problem.rules import (
@@ -34,11 +38,13 @@ from ..problem.rules import (
 )
 from ..problem.tables import SceneTables
 from .analytic import LiftOffError
-from .exact import string_state
+from .creep import solve_serpentine
+from .exact import serpentine_data, string_state
 from .geometry import Geometry, GeometryError
 from .params import DriveParams, params_of
 from .pulley_tables import SHORTHAND, LoadRule, check_pulleys, specs_of
 from .pulley_tables import max_rim_speed as driver_rim_speed
+from .tensioner import TENSIONER_RULES, check_tensioner
 
 __all__ = ["MIN_SEGMENT_ELEMENTS", "OPTIONAL_SECTIONS", "REQUIRED", "SCHEMA", "DriveParams",
            "DriveScene", "max_rim_speed", "set_key", "validate"]
@@ -88,11 +94,12 @@ SCHEMA: dict[str, dict[str, Rule]] = {
         "acceleration": Rule("float", nonneg=True),
         "max_work": POS,
     },
+    "tensioner": dict(TENSIONER_RULES),
 }
 REQUIRED = {"belt": ("height", "width", "youngs_modulus", "poisson_ratio", "shear_factor"),
             "contact": ("friction",),
             "physics": ("inertia",)}
-OPTIONAL_SECTIONS = ("stiffness", "numerics")
+OPTIONAL_SECTIONS = ("stiffness", "numerics", "tensioner")
 
 
 def validate(data: dict) -> dict:
@@ -143,6 +150,8 @@ def validate(data: dict) -> dict:
                 raise SceneError(f"{section}.{key}", "missing key")
     if "pulley" in data:
         out["pulley"] = check_pulleys(data["pulley"], out["contact"])
+    if "tensioner" in out:
+        out["tensioner"] = check_tensioner(out["tensioner"], out.get("pulley"))
     check_drive_keys(out)
     contact, physics = out["contact"], out["physics"]
     if contact["friction"] == "coulomb" and "friction_coefficient" not in contact:
@@ -193,6 +202,13 @@ def validate(data: dict) -> dict:
                          f"critical speed sqrt(a / I) = {math.sqrt(P.a / P.I):.4g} m/s "
                          f'(a - I c^2 <= 0: no steady state; physics.model = "string" has '
                          f"none)")
+    if P.tensioner is not None:
+        unloaded = replace(serpentine_data(P), loads=(0.0,) * len(P.pulleys))
+        try:
+            solve_serpentine(unloaded)
+        except NoSolutionError as exc:
+            raise SceneError("tensioner.preload", f"the arm has no equilibrium with the "
+                             f"drive unloaded: {exc}") from None
     try:
         string_state(P)
     except LiftOffError as exc:
@@ -266,6 +282,15 @@ class DriveScene(SceneTables):
     def __init__(self, data: dict, source: str | None = None):
         super().__init__(data, source)
         self.params = params_of(self._data)
+
+    def at_arm(self, beta: float) -> DriveScene:
+        """This scene with its tensioner's arm turned by ``beta`` (rad) into the belt:
+        the same tables (the scene as written), ``params`` on the turned layout with the
+        same belt (:meth:`DriveParams.at_arm`). A steady solve takes it as one layout of
+        its search for the arm's rest angle."""
+        out = copy.copy(self)
+        out.params = self.params.at_arm(beta)
+        return out
 
     @property
     def numerics(self) -> dict:

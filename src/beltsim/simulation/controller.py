@@ -17,7 +17,7 @@ import time
 import numpy as np
 
 from .. import solvers
-from ..errors import NumericalError
+from ..errors import NumericalError, SceneError
 from ..physics.grid import Grid
 from ..problem.drive import period_of, profile_times
 from ..problem.scene import Scene
@@ -79,12 +79,11 @@ class Simulation:
 
     def __init__(self, scene: Scene, grid: Grid | None = None,
                  snapshot_interval: float | None = None, loads=None):
-        self.disc = solvers.discretise(scene, grid)
-        if loads is not None:  # distributed loads (physics.discrete.Loads) on this grid
-            self.disc.loads = loads
-        self.readout = readout_of(self.disc)
-        self.scheme = solvers.get(self.disc.numerics.integrator)(self.disc)
-        self.state = self.disc.new_state()
+        self._build(scene, grid, loads)
+        if self.disc.closed and self.params.tensioner is not None and self.scheme.transient:
+            raise SceneError("tensioner", "a tensioner's arm moves in steady solves only in "
+                             'this version (numerics.integrator = "steady"); without '
+                             "[tensioner] a transient holds the pulley where it is drawn")
         self.t = 0.0
         self.wall_time = 0.0
         num = self.numerics
@@ -112,6 +111,16 @@ class Simulation:
         self.power = (PowerBalanceTracker() if hasattr(self.scheme, "work_integrals")
                       and not self.disc.closed else None)
         self._measured = None
+
+    arm_solves = 0  # the steady solves of a tensioner's search for its arm's rest angle
+
+    def _build(self, scene, grid=None, loads=None):
+        self.disc = solvers.discretise(scene, grid)
+        if loads is not None:  # distributed loads (physics.discrete.Loads) on this grid
+            self.disc.loads = loads
+        self.readout = readout_of(self.disc)
+        self.scheme = solvers.get(self.disc.numerics.integrator)(self.disc)
+        self.state = self.disc.new_state()
 
     # views ------------------------------------------------------------
     @property
@@ -312,7 +321,10 @@ class Simulation:
         start = time.perf_counter()
         status, reason, failure = RunStatus.CONVERGED, None, None
         try:
-            self.scheme.solve(self.state)
+            if self.disc.closed and self.params.tensioner is not None:
+                self._solve_arm()
+            else:
+                self.scheme.solve(self.state)
         except NumericalError as exc:
             status, reason, failure = RunStatus.FAILED, str(exc), exc.kind
             if raise_on_failure:
@@ -324,13 +336,50 @@ class Simulation:
                 tr.finalize(self, status)
         return self._result(status, reason, compile_time, failure)
 
+    def _solve_arm(self):
+        """The steady state with a tensioner's arm at rest: a steady solve of the layout
+        with the arm turned by beta (the same belt), for each beta of a root search on
+        the arm's torque (:func:`beltsim.beltdrive.tensioner.equilibrium`) started at the
+        creep theory's rest angle; the grid follows the layout, so each beta has its own
+        discretisation."""
+        from ..beltdrive.exact import string_state
+        from ..beltdrive.figures import hub_loads
+        from ..beltdrive.tensioner import equilibrium
+        from ..errors import NoSolutionError
+
+        scene, P = self.scene, self.params
+        try:
+            beta0 = string_state(P).summary()["arm_travel"] - P.arm_turn
+        except NoSolutionError:
+            beta0 = 0.0
+        solved = []
+
+        def at(beta):
+            self._build(scene.at_arm(beta))
+            self.scheme.solve(self.state)
+            solved.append(beta)
+            return self.solution()
+
+        def hub(sol):
+            Q = sol.params
+            return hub_loads(Q.layout, Q.rho, sol.c, sol.span_tensions())[P.tensioner.index]
+
+        # the beam's and the grid's arm angle differ from the creep theory's by their
+        # errors in the tensions: a first step of 1e-6 rad brackets the root at once
+        beta, _ = equilibrium(P.tensioner, P.layout, at, hub, beta0, step=1e-6, xtol=1e-12)
+        if solved[-1] != beta:
+            at(beta)
+        self.arm_solves = len(solved)
+
     def _result(self, status, reason, compile_time, failure=None) -> RunResult:
         return RunResult(
             scene=self.scene, numerics=self.numerics, status=status, reason=reason,
             failure=failure,
             time_accurate=self.scheme.time_accurate,
             solution=self.solution(), simulated_time=self.t, wall_time=self.wall_time,
-            compile_time=compile_time, statistics=self.scheme.statistics(),
+            compile_time=compile_time,
+            statistics=self.scheme.statistics() | ({"arm_solves": self.arm_solves}
+                                                   if self.arm_solves else {}),
             history=self.history.arrays(),
             power_balance=self.power.balance(self) if self.power is not None else None,
             periodic=(self.steady.last_period()

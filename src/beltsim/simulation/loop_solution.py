@@ -40,7 +40,8 @@ LOOP_ERROR_KEYS = ("span_tension", "speed_loss", "slip_arc", "hub_load", "belt_s
 
 def history_keys(P) -> tuple[str, ...]:
     """What a history records at every check: the two-pulley keys for a two-pulley
-    drive, else the driver's speed, LOOP_KEYS, :func:`~beltsim.beltdrive.figures.figure_keys` and the powers."""
+    drive, else the driver's speed, LOOP_KEYS,
+    :func:`~beltsim.beltdrive.figures.figure_keys` and the powers."""
     if P.two_pulley:
         return HISTORY_KEYS
     return ("t", "omega1", *LOOP_KEYS, *figure_keys(P.layout.names), *POWER_KEYS)
@@ -230,7 +231,8 @@ class LoopSolution:
         """The drive's figures: LOOP_KEYS, ``spans`` (a list in the belt's order of
         {from, to, tension}), ``pulleys`` (a list of {name, role, speed, slip_arc, wrap,
         torque, hub_load [Fx, Fy]}), each span's and pulley's figures under
-        :func:`~beltsim.beltdrive.figures.figure_keys`' names, the power terms, a two-pulley drive's SUMMARY_KEYS
+        :func:`~beltsim.beltdrive.figures.figure_keys`' names, the power terms, a
+        tensioner's ``arm_angle`` and ``arm_travel``, a two-pulley drive's SUMMARY_KEYS
         and, with ``path``, the driver's speed and the load of this time."""
         P = self.params
         T = self.span_tensions()
@@ -243,8 +245,9 @@ class LoopSolution:
         eff = delivered / inp if inp > 0 and delivered > 0 else math.nan
         out = {"belt_speed": self.c, "driver_torque": float(torques[d]), "efficiency": eff,
                "slip_power": float(self._terms["slip"]),
-               **layout_summary(P.layout, [p.role for p in P.pulleys], P.rho, self.c, T,
-                                 speeds, arcs, torques)}
+               **layout_summary(P.layout, P.roles, P.rho, self.c, T, speeds, arcs,
+                                torques),
+               **P.arm_figures()}
         if P.two_pulley:
             ratio = self.omega2 * P.geometry.R2 / self.rim1 if self.rim1 > 0 else math.nan
             out.update({"tight_tension": float(T[1]), "slack_tension": float(T[0]),
@@ -301,7 +304,8 @@ class LoopSolution:
         (the largest over the spans or pulleys: tensions and hub loads relative to the
         largest span tension, speed losses 1 - omega r / (omega_d r_d) relative to the
         largest, slip arcs relative to the wrap) and, for a two-pulley drive, its figures
-        one by one (relative; slip arcs over the wrap)."""
+        one by one (relative; slip arcs over the wrap); with a tensioner, ``arm_travel``
+        (rad, absolute)."""
         mine, ex = self.summary(), ref.summary()
         P = self.params
         scale = max(s["tension"] for s in ex["spans"])
@@ -319,6 +323,8 @@ class LoopSolution:
                               for a, b in zip(mine["pulleys"], ex["pulleys"]))
         for key in ("belt_speed", "driver_torque"):
             out[key] = (mine[key] - ex[key]) / abs(ex[key]) if ex[key] else abs(mine[key])
+        if P.tensioner is not None:  # rad, absolute: the drawn angle is the travel's 0
+            out["arm_travel"] = mine["arm_travel"] - ex["arm_travel"]
         if not P.two_pulley:
             return out
         keys = ["tight_tension", "slack_tension", "driven_speed"]

@@ -20,6 +20,7 @@ transient schemes (docs/theory/time-schemes.md).
 from __future__ import annotations
 
 import copy
+from dataclasses import replace
 
 import numpy as np
 
@@ -251,8 +252,10 @@ def creep_state(d, state) -> None:
     """A loop's state at the creep theory's steady state (the extensible string's exact
     one; theta = 0): Newton's start. Raises NoSolutionError where the string has none
     (gross slip, lift-off)."""
-    sol = string_state(d.params)
     P, x = d.params, d.grid.x
+    # on the layout as the grid has it: a tensioner's arm held there (its rest angle is
+    # the controller's search, Simulation._solve_arm)
+    sol = string_state(replace(P, tensioner=None))
     state.assign(type(state).zeros(len(x), d.n_globals))
     state.u[:] = sol.displacement(x)
     cn = d.mesh.cn
