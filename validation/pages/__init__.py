@@ -43,7 +43,17 @@ INDEX_INTRO = (
 
 def _pages():
     """(name, title, build) of every page, in reading order."""
-    from . import balance, convergence, drive, end_states, paper, paths, spectrum, stability
+    from . import (
+        balance,
+        convergence,
+        drive,
+        end_states,
+        paper,
+        paths,
+        serpentine,
+        spectrum,
+        stability,
+    )
 
     return (("paper", paper.TITLE, paper.build),
             ("end_states", end_states.TITLE, end_states.build),
@@ -52,7 +62,8 @@ def _pages():
             ("spectrum", spectrum.TITLE, spectrum.build),
             ("stability", stability.TITLE, stability.build),
             ("balance", balance.TITLE, balance.build),
-            ("drive", drive.TITLE, drive.build))
+            ("drive", drive.TITLE, drive.build),
+            ("serpentine", serpentine.TITLE, serpentine.build))
 
 
 def run_page(name: str, title: str, build, quick: bool, out: Path, command: str, sha: str,

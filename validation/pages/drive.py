@@ -91,7 +91,7 @@ def ladder(page: Page, quick: bool, beam: bool = False) -> list[dict]:
     if beam:
         page.para(
             "The same ladder for the beam model (the shipped scene as it is) against the "
-            "beam's exact steady state (`beltsim.beltdrive.beam.exact_state`: piecewise "
+            "beam's exact steady state (`beltsim.beltdrive.exact.exact_state`: piecewise "
             "exponentials, the slip arcs' starts as unknowns), on a ladder reaching 128 "
             "times finer. On coarse grids the slip arcs' errors scatter: the stick zones' "
             "boundary layer next to the slip front, sqrt((A + B h^2 / 4) / b2) = 4.2 mm for "

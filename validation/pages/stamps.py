@@ -55,6 +55,7 @@ SOURCES = {
                                    "validation/pages/stability.py"),
     "verification/balance.md": (*ENGINE, "validation/pages/balance.py"),
     "verification/drive.md": (*ENGINE, *DRIVE, "validation/pages/drive.py"),
+    "verification/serpentine.md": (*ENGINE, *DRIVE, "runs", "validation/pages/serpentine.py"),
     "performance/timings.md": (*ENGINE, *DRIVE, "src/beltsim/studies/bench.py",
                                "benchmarks"),
 }
