@@ -88,6 +88,14 @@ SERPENTINE_PULLEYS = [
 ]
 
 
+#: SERPENTINE_PULLEYS with a back-side idler pressing on the motor-mill span from outside
+#: the loop: the kernels' N-pulley layout (the friction on the belt's outer face there).
+SERPENTINE_BACK = [SERPENTINE_PULLEYS[0],
+                   {"name": "press", "centre": [0.3, -0.05], "radius": 0.03, "side": "back",
+                    "inertia": 1e-4},
+                   *SERPENTINE_PULLEYS[1:]]
+
+
 def serpentine_scene(pulleys=None, model="beam", **over) -> DriveScene:
     """drive_flat's belt, contact and physics on a layout of ``pulleys`` (tables of
     [[pulley]]; SERPENTINE_PULLEYS by default), with ``over`` (SECTION.KEY: value)."""
@@ -184,14 +192,14 @@ def _straight_case(law, inv_dt, seed, gyro, inertia, loads, model, grid):
 
 
 def _loop_case(layout, law, inv_dt, seed, gyro, inertia, loads, model, grid):
-    """drive_flat ("loop") or its belt on SERPENTINE_PULLEYS ("serpentine") on 60
+    """drive_flat ("loop") or its belt on SERPENTINE_BACK ("serpentine") on 60
     elements (about 60 nodes, 26 of them in contact on drive_flat); the regularised
     laws at half the creep speed, so that the random slip velocities reach their saturated
     part. The state's sizes are a time step's: u a strain of half N0 / b1 over an element
     (the pressure stays positive), theta N0 / b1, the speeds within 1e-3 and 1e-2 of the
     creep theory's."""
     scene = (DriveScene.load(scene_path("drive_flat")) if layout == "loop"
-             else serpentine_scene())
+             else serpentine_scene(SERPENTINE_BACK))
     if law == "adhesion":
         data = scene.to_dict()
         data["contact"] = {"friction": "stick"}

@@ -188,12 +188,6 @@ def validate(data: dict) -> dict:
         raise SceneError(str(exc)) from None
     speed_key = ("drive.driver_speed" if "pulley" not in out
                  else f"pulley.{P.pulleys[P.driver].name}.speed")
-    if P.model == "beam":
-        for p in P.pulleys:
-            if p.side < 0:
-                raise SceneError(f"pulley.{p.name}.side", '"back" takes physics.model = '
-                                 '"string" in this version (the beam\'s friction on its '
-                                 'outer face is not in the model yet)')
     if P.rho > 0 and max_rim_speed(out) ** 2 * P.rho >= P.b1:
         raise SceneError(speed_key, f"the rim speed reaches the belt's critical "
                          f"speed sqrt(b1 / rho) = {math.sqrt(P.b1 / P.rho):.4g} m/s")

@@ -79,6 +79,10 @@ class Mesh(NamedTuple):
     seg_speed: np.ndarray = np.zeros(0, dtype=np.int64)  # global of the rim speed, or -1
     loop_length: float = 0.0  # closed: the loop's length Lambda (m)
     inertia: np.ndarray = np.zeros(0)  # closed: J of each global (0 for c), kg m^2
+    #: the face in contact at each node: +1 the bottom fibre (lever +h/2), -1 the top
+    #: (a back-side idler's arc); a span's nodes take the next arc's, whose stencil they
+    #: enter
+    face: np.ndarray = np.ones(0)
 
 
 class State(NamedTuple):
@@ -228,4 +232,4 @@ def mesh_of(grid) -> Mesh:
     return Mesh(grid.he, grid.hbar, grid.j1, grid.j2, c0, wf, sw, off=1,
                 cn=np.arange(c0, grid.j2 + 1, dtype=np.int64), seg=seg,
                 seg_mu=np.zeros(1), seg_radius=np.zeros(1),
-                seg_speed=-np.ones(1, dtype=np.int64))
+                seg_speed=-np.ones(1, dtype=np.int64), face=np.ones(len(grid.x)))

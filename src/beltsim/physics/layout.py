@@ -69,7 +69,8 @@ class LoopGrid:
         return float(self.he.min())
 
 
-def loop_mesh(grid: LoopGrid, contacts, mu, inertia: tuple[float, ...]) -> Mesh:
+def loop_mesh(grid: LoopGrid, contacts, mu, inertia: tuple[float, ...],
+              faces=None) -> Mesh:
     """A closed layout on a periodic grid (:class:`LoopGrid`, a node at each segment's
     start).
 
@@ -77,7 +78,9 @@ def loop_mesh(grid: LoopGrid, contacts, mu, inertia: tuple[float, ...]) -> Mesh:
     tuple (segment index, radius, speed global) with speed global -1 for the driver (its
     rim speed prescribed) or the index of the free pulley's speed among the globals;
     mu: each arc's friction coefficient (0: a constant bound, perfect adhesion);
-    inertia: J of each global (0 for c).
+    inertia: J of each global (0 for c);
+    faces: each contact's face, +1 the belt's inner face (default), -1 its outer (a
+    back-side idler: the friction's lever about the middle line changes sign).
 
     Each arc's friction acts from its entry node to its exit node (the next segment's
     first), half volumes at both ends, as on the open layout's plate.
@@ -88,6 +91,12 @@ def loop_mesh(grid: LoopGrid, contacts, mu, inertia: tuple[float, ...]) -> Mesh:
     hb = 0.5 * (he + np.roll(he, 1))
     seg = -np.ones(N, dtype=np.int64)
     wf = np.zeros(N)
+    faces = np.ones(len(contacts)) if faces is None else np.asarray(faces, dtype=float)
+    face = np.ones(N)
+    # a span's nodes take the next arc's face (they enter its slip velocity's stencil)
+    for s, (k, _, _) in enumerate(contacts):
+        start, end = first[contacts[s - 1][0] + 1], first[k + 1]  # the two arcs' exits
+        face[np.arange(start + 1, end + 1 + (N if end <= start else 0)) % N] = faces[s]
     for s, (k, _, _) in enumerate(contacts):
         j0, j1 = first[k], first[k + 1]
         js = np.arange(j0, j1 + 1) % N
@@ -104,7 +113,8 @@ def loop_mesh(grid: LoopGrid, contacts, mu, inertia: tuple[float, ...]) -> Mesh:
                 seg_mu=np.asarray(mu, dtype=float),
                 seg_radius=np.array([r for _, r, _ in contacts], dtype=float),
                 seg_speed=np.array([k for _, _, k in contacts], dtype=np.int64),
-                loop_length=loop_length, inertia=np.asarray(inertia, dtype=float))
+                loop_length=loop_length, inertia=np.asarray(inertia, dtype=float),
+                face=face)
 
 
 def node_x(mesh: Mesh) -> np.ndarray:

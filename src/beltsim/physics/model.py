@@ -282,7 +282,9 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
         if closed:
             w.Rg[0] += hbj * u[j] / mesh.loop_length
         if s >= 0:
-            # slip velocity at node j (stencil sw[j]), friction on its weight wf[j]
+            # slip velocity at node j (stencil sw[j]), friction on its weight wf[j]; the
+            # lever of the face in contact (the top fibre's on a back-side idler)
+            hh = p.half_height * mesh.face[j]
             ub = u[j] + hh * th[j]
             ubo = uo[j] + hh * tho[j]
             eb = bottom_strain(u, th, hh, sw, j)
@@ -395,9 +397,10 @@ def rate_part(e, eg, a0, fs, sg, bs, c, mesh, p, out, outg):
         if mesh.seg[j] >= 0:
             S = fs if off == 1 else bs[j]
             k = friction_stiffness(mesh.wf[j], S, sg[j], p) * own_rate_slope(2, a0)
-            eb = e[i, 0] + hh * e[i, 1]
+            hf = hh * mesh.face[j]
+            eb = e[i, 0] + hf * e[i, 1]
             out[i, 0] += k * eb
-            out[i, 1] += hh * k * eb
+            out[i, 1] += hf * k * eb
         if off == 0:
             out[i, 0] += p.mass * hb[j] * a0 * eg[0]
     for k in range(eg.shape[0]):
@@ -416,10 +419,11 @@ def add_stick_penalty(w, inv_dt, fs, c, mesh, p):
         w.sg[j] *= AUGMENTATION
         S = fs if mesh.off == 1 else w.bs[j]
         k = friction_stiffness(mesh.wf[j], S, w.sg[j], p)
-        add_friction_slope(w, j - mesh.off, j, k, inv_dt, c, p.half_height, mesh.sw)
+        hf = p.half_height * mesh.face[j]
+        add_friction_slope(w, j - mesh.off, j, k, inv_dt, c, hf, mesh.sw)
         if mesh.off == 0:
             loop_friction(w, w.border, j, j, mesh.seg[j], 0.0, k, 0.0, 0.0, S, inv_dt, c,
-                          p.half_height, mesh, p, JACOBIAN)
+                          hf, mesh, p, JACOBIAN)
 
 
 # a call, not inline="always": inlined, this choice made assemble three times slower
@@ -467,7 +471,7 @@ def update_multipliers(lam, dx, dg, inv_dt, c, mesh, p, w):
             k = wrap(j - 2 + o, nn)
             if k >= off:
                 dvrel += (slip_velocity_slope(sw, j, o, c, inv_dt)
-                          * (dx[k - off, 0] + hh * dx[k - off, 1]))
+                          * (dx[k - off, 0] + hh * mesh.face[j] * dx[k - off, 1]))
         if off == 0:
             dvrel += w.vc[j] * dg[0]
             K = mesh.seg_speed[mesh.seg[j]]
@@ -528,9 +532,10 @@ def power_terms(state, t, mesh, p, drive, loads, out):
     transport = 0.0
     slip = 0.0
     for j in mesh.cn:
-        strain_b = bottom_strain(u, th, hh, mesh.sw, j)
+        hf = hh * mesh.face[j]
+        strain_b = bottom_strain(u, th, hf, mesh.sw, j)
         tj = contact_target(mesh.seg[j], c, g, rim, target, mesh, p)
-        vrel = ud[j] + hh * td[j] + c * strain_b - tj
+        vrel = ud[j] + hf * td[j] + c * strain_b - tj
         surface += tj * F[j]
         transport -= c * F[j] * strain_b
         slip -= F[j] * vrel

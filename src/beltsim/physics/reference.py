@@ -325,6 +325,7 @@ def loop_residual(u, th, lam, g, old, inv_dt, t, mesh: Mesh, p: ModelParams, dri
     K = np.where(on, mesh.seg_speed[seg], -1)
     R = np.where(on, mesh.seg_radius[seg], 1.0)
     rim = np.where(K >= 1, g[np.maximum(K, 0)] * R, value(drive.speed, t))
+    hh = hh * mesh.face  # the lever of the face in contact, node by node
     ub, ubo = u + hh * th, old.u + hh * old.theta
     vrel = (ub - ubo) * inv_dt + c * stencil(ub) - (rim - c * (1.0 + p.N0 / p.b1))
     mu = mesh.seg_mu[seg]

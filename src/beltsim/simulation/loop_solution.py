@@ -93,10 +93,10 @@ class LoopSolution:
         P, m, s = self.params, self.mesh, self.state
         N = len(self.x)
         idx = (np.arange(N)[:, None] + np.arange(-2, 1)[None, :]) % N
-        lever = prm.half_height
+        lever = prm.half_height * m.face  # the face in contact's (per node)
         # axial force: the upwind three-point strain (the friction's) at every node
         eps = np.sum(m.sw * s.u[idx], axis=1)
-        epsb = np.sum(m.sw * (s.u + lever * s.theta)[idx], axis=1)
+        epsb = np.sum(m.sw * (s.u[idx] + lever[:, None] * s.theta[idx]), axis=1)
         tension = P.N0 + P.b1 * eps
         on = m.seg >= 0
         R = np.where(on, m.seg_radius[np.maximum(m.seg, 0)], 1.0)

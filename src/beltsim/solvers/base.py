@@ -105,7 +105,8 @@ class LoopDiscretisation(Discretisation):
             self.grid, [(2 * i, p.radius, int(k)) for i, (p, k)
                         in enumerate(zip(pulleys, self.speed_global))],
             [0.0 if mu is None else mu for mu in P.mus],
-            (0.0, *(p.inertia for p in pulleys if p.role != "driver")))
+            (0.0, *(p.inertia for p in pulleys if p.role != "driver")),
+            [p.side for p in pulleys])
         code = num.law_code
         self.model: ModelParams = loop_params(
             a=P.a, b1=P.b1, b2=P.b2, rho=P.rho, I=P.I, lever=P.lever,

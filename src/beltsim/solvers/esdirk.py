@@ -138,7 +138,8 @@ def initial_ratios(state, t, mesh, p, drive):
     target = mismatch(drive, t)
     rim = value(drive.speed, t)
     for j in mesh.cn:
-        vrel = (ud[j] + hh * td[j] + c * bottom_strain(u, th, hh, mesh.sw, j)
+        hf = hh * mesh.face[j]
+        vrel = (ud[j] + hf * td[j] + c * bottom_strain(u, th, hf, mesh.sw, j)
                 - contact_target(mesh.seg[j], c, g, rim, target, mesh, p))
         s = vrel / p.regularisation
         if code == EXACT:

@@ -171,6 +171,7 @@ def _arc_sweep(j0, count, rim, ce, ff, u, th, bb, eb, db, sv, trial, co, dt, mes
     sw, wf = mesh.sw, mesh.wf
     inv_reg = 1.0 / reg
     s = mesh.seg[j0]
+    hh = hh * mesh.face[j0]  # the lever of the arc's face in contact
     mu = mesh.seg_mu[s]
     mu_r = mu / mesh.seg_radius[s]
     creep = ce * p.N0 / p.b1  # the target's part beyond the belt's total velocity
@@ -223,7 +224,7 @@ def _arc_sweep(j0, count, rim, ce, ff, u, th, bb, eb, db, sv, trial, co, dt, mes
 
 
 @njit(cache=True, error_model="numpy")
-def _commit(j0, count, trial, va, wa, db, sv, fnode, lam, co, p):
+def _commit(j0, count, trial, va, wa, db, sv, fnode, lam, co, p, face):
     """Apply an arc's accepted sweep: the forces' kick, the increments, the warm starts,
     the ratios (state.lam) and the nodal forces."""
     n = va.shape[0]
@@ -232,7 +233,7 @@ def _commit(j0, count, trial, va, wa, db, sv, fnode, lam, co, p):
         j = wrap(j0 + i, n)
         F = trial[j, T_F]
         va[j] += co[j, C_KM] * F
-        wa[j] += co[j, C_KI] * hh * F
+        wa[j] += co[j, C_KI] * hh * face[j] * F
         db[j] = trial[j, T_D]
         sv[j] = trial[j, T_S]
         lam[j] = trial[j, T_G]
@@ -270,8 +271,8 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co, arc
             et += dt / rot * load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j)
         va[j] = vb[j] + eu
         wa[j] = wb[j] + et
-        eb[j] = eu + hh * et
-        bb[j] = vb[j] + hh * wb[j] + gb[0]  # the total velocity: the belt's v + c
+        eb[j] = eu + hh * mesh.face[j] * et  # the face in contact's (or next to come)
+        bb[j] = vb[j] + hh * mesh.face[j] * wb[j] + gb[0]  # its velocity: v + c
         fnode[j] = 0.0
         gauge += hb[j] * u[j]
     ff = friction_factor(drive, t)
@@ -308,7 +309,7 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co, arc
                     G = 0.5 * (lo + hi)  # Newton left the bracket (it is finite then)
             gtot[K] = tot
             dg[K] = dt * (-load - R * tot) / J
-        _commit(j0, count, trial, va, wa, db, sv, fnode, lam, co, p)
+        _commit(j0, count, trial, va, wa, db, sv, fnode, lam, co, p, mesh.face)
     # the gauge: the uniform correction to sum hbar v = 0 is c's increment
     total = 0.0
     for j in range(n):

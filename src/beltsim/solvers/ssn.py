@@ -110,7 +110,8 @@ def saddle_system(lam, c, inv_dt, fs, mesh, p, w, s):
             continue
         k = mesh.wf[j] * (fs if off == 1 else w.bs[j])
         s.Db[i, 0, 2] = k
-        s.Db[i, 1, 2] = hh * k
+        hf = hh * mesh.face[j]  # the lever of the face in contact
+        s.Db[i, 1, 2] = hf * k
         K = mesh.seg_speed[seg] if off == 0 else -1
         if K >= 1:
             s.Gr[K, i, 2] = -mesh.seg_radius[seg] * k
@@ -135,7 +136,7 @@ def saddle_system(lam, c, inv_dt, fs, mesh, p, w, s):
                 continue
             blk = stencil_band(o, s.L2, s.Lb, s.Db)
             blk[i, 2, 0] += dd
-            blk[i, 2, 1] += dd * hh
+            blk[i, 2, 1] += dd * hf
     return changed
 
 
