@@ -14,7 +14,8 @@ import numpy as np
 
 from ..plots.common import panel_axes
 from ..plots.run import RUN_STYLE
-from .plots import CURVE_SAMPLES, analytic_parts, curve, vector
+from .plot_input import analytic_parts, curve, vector
+from .plots import CURVE_SAMPLES
 
 
 def plot_characteristic(loads, speed_loss, efficiency, *, capacity=None, analytic=None,

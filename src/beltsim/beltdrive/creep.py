@@ -328,6 +328,14 @@ class SerpentineSolution:
         """The tensioner arm's angle less the drawn one (rad), None without a tensioner."""
         return None if self.alpha is None else self.alpha - self.alpha_drawn
 
+    @property
+    def stick_ends(self) -> np.ndarray:
+        """Loop coordinates (m) where the slip arcs begin, one per slipping pulley in the
+        belt's order (the stick zone of each arc ends there; an idler has none)."""
+        g = self.layout
+        ends = g.bounds[1::2][:len(g)] - g.radii * self.phi_s
+        return ends[self.phi_s > 0]
+
     def _pieces(self):
         """N as pieces (a, b, const, amp, rate): N = const + amp exp(rate (x - a))."""
         g, rc = self.layout, self.centrifugal

@@ -67,48 +67,74 @@ def read_drive_run(run_dir):
 
 
 def plot_drive_run(run_dir, out=None) -> list:
-    """Draw a stored drive run: drive.png (to scale, coloured by tension, slip arcs),
-    fields.png (tension and friction along the loop against the analytic state) and,
-    where it has one, history.png. Returns the paths written."""
+    """Draw a stored drive run, on any layout: drive.png (to scale, coloured by tension,
+    slip arcs, hub loads), fields.png (tension and friction along the loop against the
+    exact steady state) and, where it has one, history.png. Returns the paths written."""
     from pathlib import Path
 
     from ..plots.common import save_figure
-    from . import plots
+    from . import drawing, plots
     from .exact import exact_state
 
     scene, x, f, hist, summary = read_drive_run(run_dir)
     out = prepare_outdir(out or run_dir)
-    g = scene.params.geometry
+    P = scene.params
     try:
-        ana = exact_state(scene.params)
+        ana = exact_state(P)
     except NoSolutionError:  # no steady state (gross slip): the run's own fields only
         ana = None
-    paths = [save_figure(plots.draw_drive, out / "drive.png", g, x, f["tension"],
-                         f["slip"] > 0.5, title=scene.title or Path(run_dir).name),
+    hubs = [p["hub_load"] for p in summary["pulleys"]] if "pulleys" in summary else None
+    paths = [save_figure(drawing.draw_drive, out / "drive.png", P, x, f["tension"],
+                         f["slip"] > 0.5, title=scene.title or Path(run_dir).name,
+                         hub_loads=hubs),
              save_figure(plots.plot_loop_fields, out / "fields.png", x,
-                         {"tension": f["tension"], "friction": f["friction"]}, g,
+                         {"tension": f["tension"], "friction": f["friction"]}, P,
                          analytic=ana)]
     if hist:
+        # the steady values only where the run reached them: a periodic drive's or a
+        # failed run's history is not compared with a state it never approaches
+        steady = ana.summary() if ana is not None and summary.get("converged") else None
         paths.append(save_figure(plots.plot_drive_history, out / "history.png", hist["t"],
-                                 hist))
+                                 hist, steady=steady))
     return paths
 
 
+def snapshot_frames(P, data) -> list[dict]:
+    """The frames of :func:`~beltsim.beltdrive.drawing.animate_drive` from a run's
+    snapshots (snapshots.npz read as a mapping): each one's tension, slip, belt speed,
+    hub loads (from the tension at each span's middle, as the run's summary has them
+    from its span tensions) and, on two pulleys, the driven pulley's speed."""
+    from .figures import hub_loads
+
+    g = P.layout
+    x = data["x"]
+    middles = 0.5 * (g.bounds[1:-1:2] + g.bounds[2::2])
+    frames = []
+    for i in range(len(data["t"])):
+        T = data["tension"][i]
+        c = float(data["belt_speed"][i])
+        spans = np.interp(middles, x, T, period=g.loop_length)
+        frame = {"tension": T, "slip": data["slip"][i], "belt_speed": c,
+                 "hub_loads": hub_loads(g, P.rho, c, spans)}
+        if P.two_pulley:
+            frame["driven_speed"] = float(data["driven_speed"][i])
+        frames.append(frame)
+    return frames
+
+
 def animate_drive_run(run_dir, path, fps: int = 15):
-    """Animate the snapshots of a stored drive run into ``path`` (.gif or .mp4)."""
+    """Animate the snapshots of a stored drive run, on any layout, into ``path`` (.gif
+    or .mp4)."""
     from pathlib import Path
 
     from ..errors import UsageError
-    from . import plots
+    from . import drawing
     from .scene import DriveScene
 
     run_dir = Path(run_dir)
     if not (run_dir / SNAPSHOTS).is_file():
         raise UsageError(f"{run_dir}: no {SNAPSHOTS} there (run with --snapshots INTERVAL)")
-    scene = DriveScene.load(run_dir / "scene.toml")
+    P = DriveScene.load(run_dir / "scene.toml").params
     data = np.load(run_dir / SNAPSHOTS)
-    frames = [{"tension": data["tension"][i], "slip": data["slip"][i],
-               "belt_speed": float(data["belt_speed"][i]),
-               "driven_speed": float(data["driven_speed"][i])} for i in range(len(data["t"]))]
-    return plots.animate_drive(scene.params.geometry, data["x"], frames, times=data["t"],
-                               path=path, fps=fps)
+    return drawing.animate_drive(P, data["x"], snapshot_frames(P, data), times=data["t"],
+                                 path=path, fps=fps)
