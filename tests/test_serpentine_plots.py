@@ -246,3 +246,24 @@ def test_the_two_pulley_geometry_draws_as_its_layout():
         with offscreen():
             draw_drive(P, np.linspace(0, 1, 10), np.ones(10), hub_loads=np.ones((3, 2)))
     assert math.isfinite(layout.loop_length)
+
+
+def test_a_tensioner_run_is_drawn_with_its_arm_at_rest(tmp_path):
+    """serpentine_tensioner's steady state: the drawing's layout is the run's (the pulley
+    where the arm rests, not where the scene draws it), with the arm from its pivot."""
+    scene = beltsim.load_scene("serpentine_tensioner", {"numerics.elements": 200})
+    res = beltsim.run(scene)
+    save_run(res, tmp_path)
+    travel = res.summary()["arm_travel"]
+    assert abs(travel) > 0.01  # the arm moved: the check below can tell the layouts apart
+    P = scene.params.at_arm(travel)
+    k = P.tensioner.index
+    arm = (P.tensioner.pivot, P.layout.centres[k], scene.params.layout.centres[k])
+    f = res.fields
+    with offscreen():
+        fig = draw_drive(P, res.x, f["tension"], arm=arm)
+    line = next(a for a in fig.axes[0].lines if a.get_gid() == "arm")
+    np.testing.assert_allclose(line.get_xydata()[-1], P.layout.centres[k], rtol=0,
+                               atol=1e-15)
+    assert [p.name for p in plot_drive_run(tmp_path)] == ["drive.png", "fields.png",
+                                                         "history.png"]

@@ -389,7 +389,7 @@ class DriveDrawing:
 
 
 def draw_drive(layout, x, tension, slip=None, *, ax=None, title=None, rim_speeds=None,
-               tension_range=None, hub_loads=None, roles=None):
+               tension_range=None, hub_loads=None, roles=None, arm=None):
     """The drive to scale, its belt coloured by the tension, the slip arcs marked.
 
     The pulleys are drawn where the layout puts them, each named beside its wrap (the
@@ -425,6 +425,9 @@ def draw_drive(layout, x, tension, slip=None, *, ax=None, title=None, rim_speeds
     roles : sequence of str, optional
         The pulleys' roles, to name the tight and the slack span (known already from a
         DriveParams or a Geometry).
+    arm : (pivot, centre, drawn), optional
+        A tensioner's arm: its pivot, the pulley's centre in this layout and where the
+        scene draws it (m, (x, y) each): the arm as a bar, the drawn one dashed.
 
     Returns
     -------
@@ -458,12 +461,23 @@ def draw_drive(layout, x, tension, slip=None, *, ax=None, title=None, rim_speeds
     drawing = DriveDrawing(ax, layout, x, norm, roles=roles, rim_speeds=rims,
                            hub_max=hub_max, hub_loads=hubs)
     drawing.show(tension, slip, hubs)
+    if arm is not None:
+        _draw_arm(ax, *(np.asarray(q, dtype=float) for q in arm))
     fig.colorbar(drawing.belt, ax=ax, label="belt tension N [N]", shrink=0.9)
     drawing.legend(ax, slip=slip is not None and bool(slip.any()))
     if title:
         # a scene's title may be long: wrapped to the drawing's width, not cut off
         ax.set_title(textwrap.fill(title, int(10.0 * fig.get_size_inches()[0])), fontsize=10)
     return fig
+
+
+def _draw_arm(ax, pivot, centre, drawn):
+    """A tensioner's arm from its pivot to the pulley's centre, and dashed where the
+    scene draws it (its travel between the two)."""
+    ax.plot(*np.column_stack([pivot, drawn]), color="0.55", lw=1.5, ls="--", zorder=5)
+    ax.plot(*np.column_stack([pivot, centre]), color="0.25", lw=4.0, zorder=5,
+            solid_capstyle="round", gid="arm", label="tensioner arm (drawn: dashed)")
+    ax.plot(*pivot, marker="o", ms=7, mfc="white", mec="0.25", zorder=6)
 
 
 def animate_drive(layout, x, frames, *, times, path, fps=20, dpi=80, roles=None):

@@ -78,7 +78,12 @@ def plot_drive_run(run_dir, out=None) -> list:
 
     scene, x, f, hist, summary = read_drive_run(run_dir)
     out = prepare_outdir(out or run_dir)
-    P = scene.params
+    P, arm = scene.params, None
+    if P.tensioner is not None:  # the run's layout: the tensioner's arm at rest
+        k = P.tensioner.index
+        drawn = P.layout.centres[k]
+        P = P.at_arm(summary.get("arm_travel") or 0.0)
+        arm = (P.tensioner.pivot, P.layout.centres[k], drawn)
     try:
         ana = exact_state(P)
     except NoSolutionError:  # no steady state (gross slip): the run's own fields only
@@ -86,7 +91,7 @@ def plot_drive_run(run_dir, out=None) -> list:
     hubs = [p["hub_load"] for p in summary["pulleys"]] if "pulleys" in summary else None
     paths = [save_figure(drawing.draw_drive, out / "drive.png", P, x, f["tension"],
                          f["slip"] > 0.5, title=scene.title or Path(run_dir).name,
-                         hub_loads=hubs),
+                         hub_loads=hubs, arm=arm),
              save_figure(plots.plot_loop_fields, out / "fields.png", x,
                          {"tension": f["tension"], "friction": f["friction"]}, P,
                          analytic=ana)]
