@@ -40,7 +40,8 @@ LOOP_ERROR_KEYS = ("span_tension", "speed_loss", "slip_arc", "hub_load", "belt_s
 
 def history_keys(P) -> tuple[str, ...]:
     """What a history records at every check: the two-pulley keys for a two-pulley
-    drive, else the driver's speed, LOOP_KEYS, :func:`~beltsim.beltdrive.figures.figure_keys` and the powers."""
+    drive, else the driver's speed, LOOP_KEYS,
+    :func:`~beltsim.beltdrive.figures.figure_keys` and the powers."""
     if P.two_pulley:
         return HISTORY_KEYS
     return ("t", "omega1", *LOOP_KEYS, *figure_keys(P.layout.names), *POWER_KEYS)
@@ -230,7 +231,8 @@ class LoopSolution:
         """The drive's figures: LOOP_KEYS, ``spans`` (a list in the belt's order of
         {from, to, tension}), ``pulleys`` (a list of {name, role, speed, slip_arc, wrap,
         torque, hub_load [Fx, Fy]}), each span's and pulley's figures under
-        :func:`~beltsim.beltdrive.figures.figure_keys`' names, the power terms, a two-pulley drive's SUMMARY_KEYS
+        :func:`~beltsim.beltdrive.figures.figure_keys`' names, the power terms, a
+        two-pulley drive's SUMMARY_KEYS
         and, with ``path``, the driver's speed and the load of this time."""
         P = self.params
         T = self.span_tensions()
