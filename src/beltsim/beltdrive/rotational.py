@@ -126,4 +126,52 @@ def rotational_model(params) -> RotationalModel:
         stiffness=K[np.ix_(keep, keep)], signed_radii=q[keep], span_stiffness=k)
 
 
-__all__ = ["RotationalModel", "rotational_model", "stiffness_matrix"]
+#: The limit's belt: the scene's density times this. Far smaller loses digits: the belt
+#: model's linearisation is read off its Jacobian at rates of the grid's highest frequency
+#: sqrt(b1 / rho) / h (at 1e-6 drive_flat's frequency is 1.6e-4 off, and the string's
+#: rotary rows show spurious growing pairs at MHz)
+LIGHT = 1e-4
+
+
+def adhesion_limit(scene, light: float = LIGHT, speed: float = 0.5, elements: int = 100):
+    """A drive scene in the rotational model's limit.
+
+    Perfect adhesion (``contact.friction = "stick"``), no load torques (both tensions of
+    every pulley equal: no creep), the belt ``light`` times as dense, no damping, the
+    string, the driver at ``speed`` rad/s: so slow that the transport of the strain
+    frozen on the stuck arcs shows as overdamped pairs of a few hertz, apart from the
+    rotational modes.
+
+    Parameters
+    ----------
+    scene : DriveScene
+        The drive.
+    light : float, optional
+        The belt's density factor.
+    speed : float, optional
+        The driver's speed (rad/s).
+    elements : int, optional
+        The grid (numerics.elements).
+
+    Returns
+    -------
+    DriveScene
+    """
+    data = scene.to_dict()
+    data["contact"] = {"friction": "stick"}
+    for p in data.get("pulley", []):
+        p.pop("friction_coefficient", None)
+        if "load_torque" in p:
+            p["load_torque"] = 0.0
+        if "speed" in p:
+            p["speed"] = speed
+    if "driver_speed" in data["drive"]:
+        data["drive"].update(driver_speed=speed, load_torque=0.0)
+    data["belt"]["density"] *= light
+    data["physics"].update(damping=0.0, model="string")
+    data.setdefault("numerics", {})["elements"] = elements
+    return type(scene).from_dict(data)
+
+
+__all__ = ["LIGHT", "RotationalModel", "adhesion_limit", "rotational_model",
+           "stiffness_matrix"]

@@ -225,7 +225,8 @@ def _mode(disc, lam, z, samples) -> Mode:
     # the largest displacement, of the belt or a rim, is 1 and real
     cand = np.concatenate([us, radii * theta])
     top = int(np.argmax(np.abs(cand)))
-    scale = cand[top]
+    # a mode of the string's rotary unknowns alone moves neither belt nor rims: unscaled
+    scale = cand[top] if cand[top] != 0.0 else 1.0
     inertia = np.array([p.inertia for p in P.pulleys])
     pulley_ke = float(np.sum(inertia * np.abs(speeds) ** 2))
     belt_ke = float(P.rho * np.sum(disc.mesh.hb * np.abs(lam * u) ** 2))
