@@ -107,7 +107,7 @@ def rotational_model(params) -> RotationalModel:
     Parameters
     ----------
     params : DriveParams
-        The drive (:attr:`DriveScene.params <beltsim.beltdrive.scene.DriveScene.params>`):
+        The drive (a drive scene's ``params``):
         its layout's spans and sides, its pulleys' radii and inertias, b1 = EA.
 
     Returns

@@ -4,11 +4,11 @@ belt motion.
 
 A mode y = y0 + z e^{lambda t} has its rate Re lambda (1/s; > 0 grows) and its frequency
 Im lambda / (2 pi) (Hz); each conjugate pair is kept once (Im lambda > 0). Only the
-modes that oscillate are listed, those with a damping ratio -Re lambda / |lambda| below
+modes that oscillate are listed, those with a damping ratio -Re lambda / abs(lambda) below
 MAX_DAMPING_RATIO: the linearisation also has real and overdamped eigenvalues by the
 hundred (the stuck nodes' penalty, a stiff dashpot, and the transport of the strain
 frozen on the stuck arcs), with rates down to -1e10 1/s. All of them count for
-:attr:`DriveModes.least_stable`. A mode's shape:
+``DriveModes.least_stable``. A mode's shape:
 
 * each pulley's speed perturbation (a loop's speeds are first-order unknowns) and its
   rotation theta = speed / lambda, in the sense the belt turns the pulley (the driver's
@@ -17,10 +17,11 @@ frozen on the stuck arcs), with rates down to -1e10 1/s. All of them count for
 * the belt's axial displacement u along the loop coordinate (from the entry of the first
   pulley's arc, in the belt's direction), sampled at equal steps;
 
-scaled so that the largest of |u| and the pulleys' rim displacements |r theta| is 1 and
-real positive. ``pulley_share`` is the pulleys' part of the mode's kinetic energy,
-sum J |speed|^2 over that plus the belt's sum rho hbar_j |lambda u_j|^2 (the Eulerian
-rate of u: the belt's transport of its perturbation is left out of this measure).
+scaled so that the largest of abs(u) and the pulleys' rim displacements abs(r theta) is
+1 and real positive. ``pulley_share`` is the pulleys' part of the mode's kinetic energy,
+sum J abs(speed)^2 over that plus the belt's sum rho hbar_j abs(lambda u_j)^2 (the
+Eulerian rate of u: the belt's transport of its perturbation is left out of this
+measure).
 """
 
 from __future__ import annotations
@@ -76,7 +77,7 @@ class Mode:
 
     @property
     def damping_ratio(self) -> float:
-        """-Re lambda / |lambda|."""
+        """-Re lambda / abs(lambda)."""
         return -self.eigenvalue.real / abs(self.eigenvalue)
 
     def to_dict(self) -> dict:
