@@ -24,7 +24,7 @@ from .problem.scene import Scene
 from .problem.shipped import paper_scene_name, scene_names, shipped_text
 from .problem.tomlio import parse_toml, read_scene_file
 
-__all__ = ["is_drive_scene", "load_scene", "paper_scene", "run", "scene_from_tables",
+__all__ = ["is_drive_scene", "load_scene", "modes", "paper_scene", "run", "scene_from_tables",
            "scene_names", "shipped_scene", "solve"]
 
 if TYPE_CHECKING:
@@ -222,3 +222,50 @@ def solve(scene, model: str | None = None, overrides=()):
     if model not in (None, "stick", "slip"):
         raise UsageError(f'model: must be "stick" or "slip" for a straight belt, got {model!r}')
     return solve_straight(scene, model)
+
+
+def modes(scene, count: int | None = None, f_max: float | None = None,
+          elements: int | None = None, overrides=()):
+    """The lowest modes of a closed drive linearised about its steady state.
+
+    Parameters
+    ----------
+    scene : DriveScene, str, Path or dict
+        What :func:`load_scene` takes; a closed drive with inertia.
+    count : int, optional
+        List at most this many modes, the lowest (default 10 when ``f_max`` is None).
+    f_max : float, optional
+        List only the modes up to this frequency (Hz).
+    elements : int, optional
+        The grid (default the scene's ``numerics.elements``, else 200: a dense
+        eigensolver).
+    overrides : dict, str or iterable of str or (str, value), optional
+        Keys to set first.
+
+    Returns
+    -------
+    DriveModes
+        The modes by increasing frequency (:mod:`beltsim.physics.loop_modes`): each
+        one's eigenvalue and shape, and the least stable eigenvalue.
+
+    Raises
+    ------
+    UsageError
+        A straight belt (no pulleys), or a bad count, bound or grid.
+    SceneError
+        A quasistatic drive.
+    NumericalError
+        The steady state could not be solved for.
+
+    Examples
+    --------
+    >>> found = beltsim.modes("serpentine_accessory", count=6)   # doctest: +SKIP
+    >>> print(found.table())                                   # doctest: +SKIP
+    """
+    scene = load_scene(scene, overrides)
+    if not is_drive_scene(scene):
+        raise UsageError("modes: a closed drive's (a scene with [drive]); this is a straight "
+                         "belt")
+    from .physics.loop_modes import drive_modes
+
+    return drive_modes(scene, count=count, f_max=f_max, elements=elements)

@@ -423,6 +423,20 @@ def cmd_plot(args):
     return 0
 
 
+def cmd_modes(args):
+    from pathlib import Path
+
+    from .api import modes
+    from .io.files import prepare_outdir, write_json
+
+    found = modes(_scene(args), count=args.count, f_max=args.f_max, elements=args.elements)
+    out = prepare_outdir(args.out or Path("runs/out") / f"modes_{Path(args.scene).stem}")
+    write_json(out / "modes.json", found.to_list())
+    print(found.table())
+    print(f"wrote {out / 'modes.json'}")
+    return 0
+
+
 def cmd_scenes(args):
     from .api import scene_names, shipped_scene
     from .errors import MissingInputError
@@ -531,6 +545,17 @@ def build_parser():
     p.add_argument("--elements", type=int, default=None,
                    help="run every case on this many elements (a quick, coarse matrix)")
     p.set_defaults(func=cmd_stability)
+
+    p = sub.add_parser("modes", help="a drive's lowest modes about its steady state: "
+                       "frequencies, growth rates, pulley and belt shapes (modes.json)")
+    _add_scene_args(p)
+    p.add_argument("--out", default=None, help="output directory (default runs/out/modes_SCENE)")
+    p.add_argument("--count", type=int, default=None, help="at most this many modes, the "
+                   "lowest (default 10 without --f-max)")
+    p.add_argument("--f-max", type=float, default=None, help="only modes up to this (Hz)")
+    p.add_argument("--elements", type=int, default=None,
+                   help="the grid (default the scene's numerics.elements, else 200)")
+    p.set_defaults(func=cmd_modes)
 
     p = sub.add_parser("bench", help="wall times of the default and steady runs, the explicit "
                        "kernel's speed, import beltsim, a warm run end to end and a cold start "

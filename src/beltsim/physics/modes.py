@@ -155,6 +155,33 @@ def spectrum(disc, state) -> np.ndarray:
     return alpha[finite] / beta[finite]
 
 
+def eigenpairs(disc, state) -> tuple[np.ndarray, np.ndarray]:
+    """Every finite eigenvalue of the linearisation and its mode (dense; small grids).
+
+    Returns
+    -------
+    lam : numpy.ndarray
+        The finite eigenvalues (complex, 1/s), in LAPACK's order.
+    Z : numpy.ndarray
+        Their modes z (columns) over the unknowns of :func:`linearisation`: each node's
+        (u, theta), then a loop's globals (its speeds, first-order unknowns: their
+        perturbations, not displacements). Each column has unit 2-norm over (z, z').
+    """
+    M, C, K = linearisation(disc, state)
+    A, B = pencil(M, C, K)
+    n = K.shape[0]
+    if B is None:
+        lam, V = scipy.linalg.eig(A.toarray(), overwrite_a=True, check_finite=False)
+        return lam, V[:n]
+    (alpha, beta), V = scipy.linalg.eig(A.toarray(), B.toarray(), homogeneous_eigvals=True,
+                                        overwrite_a=True, check_finite=False)
+    from ..solvers.linearise import highest_frequency
+
+    # as in spectrum: B's null space gives beta = 0 or its round-off
+    finite = np.abs(beta) * INFINITE * highest_frequency(disc) > np.abs(alpha)
+    return alpha[finite] / beta[finite], V[:n, finite]
+
+
 def growth_rate(scene, dense_elements=None) -> Growth:
     """The largest real part of the eigenvalues of the scene's discrete model (its own
     grid, numerics.elements or the default) linearised about its steady state.

@@ -1,0 +1,244 @@
+"""A closed drive's modes: the eigenvalues and mode shapes of its discrete model linearised
+about its steady state (:mod:`beltsim.physics.modes`), read as the drive's rotational and
+belt motion.
+
+A mode y = y0 + z e^{lambda t} has its rate Re lambda (1/s; > 0 grows) and its frequency
+Im lambda / (2 pi) (Hz); each conjugate pair is kept once (Im lambda > 0). Only the
+modes that oscillate are listed, those with a damping ratio -Re lambda / abs(lambda) below
+MAX_DAMPING_RATIO: the linearisation also has real and overdamped eigenvalues by the
+hundred (the stuck nodes' penalty, a stiff dashpot, and the transport of the strain
+frozen on the stuck arcs), with rates down to -1e10 1/s. All of them count for
+``DriveModes.least_stable``. A mode's shape:
+
+* each pulley's speed perturbation (a loop's speeds are first-order unknowns) and its
+  rotation theta = speed / lambda, in the sense the belt turns the pulley (the driver's
+  speed is prescribed: 0); :attr:`PulleyLayout.spin
+  <beltsim.beltdrive.pulleys.PulleyLayout.spin>` tells that sense in the plane;
+* the belt's axial displacement u along the loop coordinate (from the entry of the first
+  pulley's arc, in the belt's direction), sampled at equal steps;
+
+scaled so that the largest of abs(u) and the pulleys' rim displacements abs(r theta) is
+1 and real positive. ``pulley_share`` is the pulleys' part of the mode's kinetic energy,
+sum J abs(speed)^2 over that plus the belt's sum rho hbar_j abs(lambda u_j)^2 (the
+Eulerian rate of u: the belt's transport of its perturbation is left out of this
+measure).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import SceneError, UsageError
+from .modes import eigenpairs, steady_discretisation
+
+#: The grid when the scene sets none: the dense QZ algorithm's cost grows as the cube of
+#: the grid (`beltsim modes serpentine_accessory`: 6 s end to end on 200 elements, 33 s on
+#: 400)
+DEFAULT_ELEMENTS = 200
+#: Beyond this the dense eigensolver takes minutes and gigabytes
+MAX_ELEMENTS = 800
+#: Modes listed when neither a count nor a frequency bound is given
+DEFAULT_COUNT = 10
+#: Samples of the belt's displacement along the loop in a mode's shape
+SAMPLES = 120
+#: A mode more damped than this is not listed (it decays by exp(-3.6) over one period;
+#: the penalty's and the transport's overdamped pairs have damping ratios near 1)
+MAX_DAMPING_RATIO = 0.5
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One mode of the linearised drive: its eigenvalue and shape (see the module)."""
+
+    eigenvalue: complex
+    #: each pulley's (rotation (rad), speed perturbation (rad/s)), by name
+    pulleys: dict
+    #: the belt speed's perturbation (m/s)
+    belt_speed: complex
+    #: loop coordinate of the belt's samples (m) and u there (m)
+    x: np.ndarray
+    u: np.ndarray
+    pulley_share: float
+    #: what moves most: a pulley's name (its rim) or "belt"
+    largest: str
+
+    @property
+    def frequency_hz(self) -> float:
+        """Im lambda / (2 pi) (Hz)."""
+        return self.eigenvalue.imag / (2.0 * math.pi)
+
+    @property
+    def rate(self) -> float:
+        """Re lambda (1/s): > 0 grows."""
+        return self.eigenvalue.real
+
+    @property
+    def damping_ratio(self) -> float:
+        """-Re lambda / abs(lambda)."""
+        return -self.eigenvalue.real / abs(self.eigenvalue)
+
+    def to_dict(self) -> dict:
+        """The mode as JSON-ready data (complex numbers as [real, imag])."""
+        def pair(z):
+            return [float(z.real), float(z.imag)]
+        return {
+            "frequency_hz": self.frequency_hz, "rate": self.rate,
+            "damping_ratio": self.damping_ratio, "pulley_share": self.pulley_share,
+            "largest": self.largest,
+            "shape": {
+                "pulleys": {name: {"rotation": pair(th), "speed": pair(w)}
+                            for name, (th, w) in self.pulleys.items()},
+                "belt_speed": pair(self.belt_speed),
+                "belt": {"x": self.x.tolist(), "u_real": self.u.real.tolist(),
+                         "u_imag": self.u.imag.tolist()}}}
+
+
+@dataclass(frozen=True)
+class DriveModes:
+    """The lowest modes of a drive linearised about its steady state.
+
+    Attributes
+    ----------
+    modes : tuple of Mode
+        By increasing frequency.
+    least_stable : complex
+        The eigenvalue with the largest real part among all the finite ones (real ones
+        included, and those beyond the listed band).
+    elements : int
+        The grid's elements.
+    eigenvalues : int
+        How many finite eigenvalues the linearisation has.
+    """
+
+    modes: tuple[Mode, ...]
+    least_stable: complex
+    elements: int
+    eigenvalues: int
+
+    def to_list(self) -> list[dict]:
+        """What ``beltsim modes`` writes to modes.json."""
+        return [m.to_dict() for m in self.modes]
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """The listed modes' frequencies (Hz)."""
+        return np.array([m.frequency_hz for m in self.modes])
+
+    @property
+    def rates(self) -> np.ndarray:
+        """The listed modes' rates (1/s)."""
+        return np.array([m.rate for m in self.modes])
+
+    def growing(self) -> list[Mode]:
+        """The listed modes that grow (rate > 0)."""
+        return [m for m in self.modes if m.rate > 0.0]
+
+    def table(self) -> str:
+        """A short table: frequency, rate, damping ratio, pulley share and what moves
+        most (a pulley's rim or the belt), then the least stable eigenvalue."""
+        lines = [f"{'#':>3}  {'f [Hz]':>10}  {'rate [1/s]':>11}  {'zeta':>9}  "
+                 f"{'pulleys':>7}  moves most"]
+        for k, m in enumerate(self.modes):
+            lines.append(f"{k:>3}  {m.frequency_hz:>10.4f}  {m.rate:>+11.4g}  "
+                         f"{m.damping_ratio:>9.2e}  {m.pulley_share:>7.3f}  {m.largest}")
+        lam = self.least_stable
+        verdict = "grows" if lam.real > 0.0 else "decays"
+        lines.append(f"least stable eigenvalue of {self.eigenvalues} ({self.elements} "
+                     f"elements): {lam.real:+.4g} 1/s at {abs(lam.imag) / (2 * math.pi):.4g} "
+                     f"Hz ({verdict})")
+        return "\n".join(lines)
+
+
+def check_options(count, f_max, elements) -> None:
+    """UsageError on a bad count, frequency bound or grid."""
+    if count is not None and not (isinstance(count, int) and count >= 1):
+        raise UsageError(f"--count: must be an integer >= 1, got {count!r}")
+    if f_max is not None and not (math.isfinite(f_max) and f_max > 0):
+        raise UsageError(f"--f-max: must be > 0 Hz, got {f_max!r}")
+    if elements is not None and not (isinstance(elements, int)
+                                     and 8 <= elements <= MAX_ELEMENTS):
+        raise UsageError(f"--elements: must be an integer in [8, {MAX_ELEMENTS}] (a dense "
+                         f"eigensolver), got {elements!r}")
+
+
+def drive_modes(scene, count: int | None = None, f_max: float | None = None,
+                elements: int | None = None, samples: int = SAMPLES) -> DriveModes:
+    """The lowest modes of a closed drive's discrete model about its steady state.
+
+    Parameters
+    ----------
+    scene : DriveScene
+        A drive with inertia (``physics.inertia = true``).
+    count : int, optional
+        List at most this many modes (the lowest); DEFAULT_COUNT when ``f_max`` is None
+        too.
+    f_max : float, optional
+        List only the modes up to this frequency (Hz).
+    elements : int, optional
+        The grid; default the scene's ``numerics.elements``, else DEFAULT_ELEMENTS.
+    samples : int, optional
+        Samples of the belt's displacement in each shape.
+
+    Returns
+    -------
+    DriveModes
+
+    Raises
+    ------
+    UsageError
+        A bad count, bound or grid.
+    SceneError
+        A quasistatic drive (no dynamics to linearise).
+    NumericalError
+        The steady state could not be solved for.
+    """
+    check_options(count, f_max, elements)
+    P = scene.params
+    if not P.inertia:
+        raise SceneError("physics.inertia", "a quasistatic drive has no modes (set it true)")
+    if elements is None:
+        elements = min(scene.numerics.get("elements", DEFAULT_ELEMENTS), MAX_ELEMENTS)
+    if count is None and f_max is None:
+        count = DEFAULT_COUNT
+    disc, state = steady_discretisation(scene, elements)
+    lam, Z = eigenpairs(disc, state)
+    least = complex(lam[np.argmax(lam.real)])
+    keep = (lam.imag > 0.0) & (-lam.real < MAX_DAMPING_RATIO * np.abs(lam))
+    if f_max is not None:
+        keep &= lam.imag <= 2.0 * math.pi * f_max
+    order = np.flatnonzero(keep)[np.argsort(lam.imag[keep], kind="stable")][:count]
+    found = tuple(_mode(disc, lam[k], Z[:, k], samples) for k in order)
+    return DriveModes(found, least, disc.grid.n_elements, len(lam))
+
+
+def _mode(disc, lam, z, samples) -> Mode:
+    P, grid = disc.params, disc.grid
+    N = grid.n_elements
+    u = z[0:2 * N:2]
+    speeds = np.array([0.0 if k < 0 else z[2 * N + k] for k in disc.speed_global],
+                      dtype=complex)
+    theta = speeds / lam
+    radii = np.array([p.radius for p in P.pulleys])
+    xs = np.linspace(0.0, grid.loop_length, samples, endpoint=False)
+    us = np.interp(xs, grid.x, u, period=grid.loop_length)
+    # the largest displacement, of the belt or a rim, is 1 and real
+    cand = np.concatenate([us, radii * theta])
+    top = int(np.argmax(np.abs(cand)))
+    # a mode of the string's rotary unknowns alone moves neither belt nor rims: unscaled
+    scale = cand[top] if cand[top] != 0.0 else 1.0
+    inertia = np.array([p.inertia for p in P.pulleys])
+    pulley_ke = float(np.sum(inertia * np.abs(speeds) ** 2))
+    belt_ke = float(P.rho * np.sum(disc.mesh.hb * np.abs(lam * u) ** 2))
+    share = pulley_ke / (pulley_ke + belt_ke) if pulley_ke + belt_ke > 0 else 0.0
+    return Mode(complex(lam), {p.name: (complex(t / scale), complex(w / scale))
+                               for p, t, w in zip(P.pulleys, theta, speeds)},
+                complex(z[2 * N] / scale), xs, us / scale, share,
+                "belt" if top < samples else P.pulleys[top - samples].name)
+
+
+__all__ = ["DEFAULT_COUNT", "DEFAULT_ELEMENTS", "DriveModes", "MAX_DAMPING_RATIO",
+           "MAX_ELEMENTS", "Mode",
+           "drive_modes"]
