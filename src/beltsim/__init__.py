@@ -33,8 +33,8 @@ __version__ = "0.1.0"
 # Imported on first use: they bring numba, scipy.optimize and matplotlib, a second of
 # `import beltsim` that listing scenes or building one does not need.
 _LAZY = {
-    "load_scene": "api", "modes": "api", "paper_scene": "api", "run": "api", "scene_names": "api",
-    "shipped_scene": "api", "solve": "api",
+    "forced_response": "api", "load_scene": "api", "modes": "api", "paper_scene": "api",
+    "run": "api", "scene_names": "api", "shipped_scene": "api", "solve": "api",
     "save_run": "io.results", "plot_fields": "plots.run", "plot_history": "plots.run",
     "AnalyticSolution": "problem.analytic",
     "Simulation": "simulation.controller",
@@ -66,6 +66,6 @@ __all__ = [
     "AnalyticSolution", "Beam", "BeltsimError", "Contact", "MissingInputError", "Motion",
     "NoSolutionError", "NumericalError", "NumericsSection", "Physics", "RunResult",
     "RunStatus", "Scene", "SceneError", "Simulation", "Sine", "Stiffness", "Stop", "Tracker",
-    "load_scene", "modes", "paper_scene", "plot_fields", "plot_history", "run", "save_run",
-    "scene_names", "shipped_scene", "solve",
+    "forced_response", "load_scene", "modes", "paper_scene", "plot_fields", "plot_history",
+    "run", "save_run", "scene_names", "shipped_scene", "solve",
 ]

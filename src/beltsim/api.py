@@ -24,8 +24,8 @@ from .problem.scene import Scene
 from .problem.shipped import paper_scene_name, scene_names, shipped_text
 from .problem.tomlio import parse_toml, read_scene_file
 
-__all__ = ["is_drive_scene", "load_scene", "modes", "paper_scene", "run", "scene_from_tables",
-           "scene_names", "shipped_scene", "solve"]
+__all__ = ["forced_response", "is_drive_scene", "load_scene", "modes", "paper_scene", "run",
+           "scene_from_tables", "scene_names", "shipped_scene", "solve"]
 
 if TYPE_CHECKING:
     from .beltdrive.scene import DriveScene
@@ -269,3 +269,44 @@ def modes(scene, count: int | None = None, f_max: float | None = None,
     from .physics.loop_modes import drive_modes
 
     return drive_modes(scene, count=count, f_max=f_max, elements=elements)
+
+
+def forced_response(scene, frequencies, elements: int | None = None, overrides=()):
+    """A closed drive's linear response to a sine on its driver's speed.
+
+    Parameters
+    ----------
+    scene : DriveScene, str, Path or dict
+        What :func:`load_scene` takes; a closed drive with inertia.
+    frequencies : array_like
+        The fluctuation's frequencies (Hz).
+    elements : int, optional
+        The grid (default the scene's ``numerics.elements``, else 200).
+    overrides : dict, str or iterable of str or (str, value), optional
+        Keys to set first.
+
+    Returns
+    -------
+    ForcedResponse
+        Each span's tension and each free pulley's speed per rad/s of the driver's
+        amplitude, complex (:mod:`beltsim.physics.loop_modes`).
+
+    Raises
+    ------
+    UsageError
+        A straight belt, or bad frequencies.
+    SceneError
+        A quasistatic drive.
+
+    Examples
+    --------
+    >>> fr = beltsim.forced_response("serpentine_accessory", [20, 48, 100])  # doctest: +SKIP
+    >>> fr.amplitudes(1.5)["tension[pump-crankshaft]"]                     # doctest: +SKIP
+    """
+    scene = load_scene(scene, overrides)
+    if not is_drive_scene(scene):
+        raise UsageError("forced_response: a closed drive's (a scene with [drive]); this is "
+                         "a straight belt")
+    from .physics.loop_modes import forced_response as linear_response
+
+    return linear_response(scene, frequencies, elements=elements)

@@ -242,3 +242,86 @@ def _mode(disc, lam, z, samples) -> Mode:
 __all__ = ["DEFAULT_COUNT", "DEFAULT_ELEMENTS", "DriveModes", "MAX_DAMPING_RATIO",
            "MAX_ELEMENTS", "Mode",
            "drive_modes"]
+
+
+@dataclass(frozen=True)
+class ForcedResponse:
+    """A drive's linear response to a sine on its driver's speed, per rad/s of it.
+
+    ``frequencies`` (Hz); ``tension``: each span's tension amplitude (N per rad/s), by its
+    figure key ``tension[A-B]``, at the span's middle; ``speed``: each free pulley's speed
+    amplitude (rad/s per rad/s), by ``speed[A]``. Complex: abs() the amplitude, angle()
+    the phase against the driver's speed.
+    """
+
+    frequencies: np.ndarray
+    tension: dict
+    speed: dict
+
+    def amplitudes(self, amplitude: float = 1.0) -> dict:
+        """Every figure's amplitude for a driver's speed amplitude (rad/s), by key."""
+        return {k: amplitude * np.abs(v) for k, v in (self.tension | self.speed).items()}
+
+
+def forced_response(scene, frequencies, elements: int | None = None) -> ForcedResponse:
+    """The drive linearised about its steady state, driven by a sine on its driver's
+    speed: (-w^2 M + i w C + K) z = f at each frequency (f:
+    :func:`beltsim.solvers.linearise.driver_forcing`), read as span tensions and pulley
+    speeds. Valid while the sine is small enough that no node changes between stick and
+    slip (the runs' periodic states show where that fails).
+
+    Parameters
+    ----------
+    scene : DriveScene
+        A drive with inertia.
+    frequencies : array_like
+        The driver's fluctuation frequencies (Hz), > 0.
+    elements : int, optional
+        The grid; default the scene's, else DEFAULT_ELEMENTS.
+
+    Returns
+    -------
+    ForcedResponse
+    """
+    import scipy.sparse.linalg as spla
+
+    from ..beltdrive.figures import figure_keys
+    from ..solvers.linearise import driver_forcing
+    from .modes import linearisation
+
+    f_hz = np.atleast_1d(np.asarray(frequencies, dtype=float))
+    if f_hz.size == 0 or not np.all(np.isfinite(f_hz) & (f_hz > 0)):
+        raise UsageError("frequencies: must be numbers > 0 (Hz)")
+    P = scene.params
+    if not P.inertia:
+        raise SceneError("physics.inertia", "a quasistatic drive has no forced response "
+                         "(set it true)")
+    if elements is None:
+        elements = scene.numerics.get("elements", DEFAULT_ELEMENTS)
+    disc, state = steady_discretisation(scene, elements)
+    M, C, K = linearisation(disc, state)
+    rhs = driver_forcing(disc, state)
+    P, grid = disc.params, disc.grid
+    n = grid.n_elements
+    b = (len(rhs) - disc.n_globals) // n
+    g = P.layout
+    names = g.names
+    keys = figure_keys(names)
+    # each span's middle element: its strain (u_{e+1} - u_e) / h_e
+    mids = 0.5 * (g.bounds[1:-1:2] + g.bounds[2::2])
+    e = np.searchsorted(grid.x, mids) - 1
+    tension = {keys[i]: np.zeros(f_hz.size, complex) for i in range(len(names))}
+    speed = {f"speed[{p.name}]": np.zeros(f_hz.size, complex)
+             for p, k in zip(P.pulleys, disc.speed_global) if k >= 0}
+    he = grid.he
+    for m, f in enumerate(f_hz):
+        w = 2.0 * math.pi * f
+        z = spla.spsolve((-w * w * M + 1j * w * C + K).tocsc(), rhs.astype(complex))
+        u = z[0:b * n:b]
+        for i in range(len(names)):
+            j = e[i]
+            tension[keys[i]][m] = P.b1 * (u[(j + 1) % n] - u[j]) / he[j]
+        for p, k in zip(P.pulleys, disc.speed_global):
+            if k >= 0:
+                speed[f"speed[{p.name}]"][m] = z[b * n + k]
+    return ForcedResponse(f_hz, tension, speed)

@@ -79,24 +79,10 @@ def linearisation(disc, state):
     """(M, C, K) of the layout's semi-discrete model about its steady ``state`` (sparse,
     over (u, theta) of each unknown node, then the globals), with the scene's own damping
     (numerics.acceleration belongs to the pseudo scheme's path)."""
-    P = disc.params
-    # the primal form: the Jacobian is then the residual's whole derivative
-    p = disc.model._replace(damping=P.damping, dual=0)
-    old = state._replace(ud=np.zeros_like(state.ud), td=np.zeros_like(state.td),
-                         gd=np.zeros_like(state.gd))
-    drive = disc.steady_drive()
-    w = Workspace.allocate(disc.grid.n_elements, is_exact(p.law), disc.closed,
-                           disc.n_globals)
-    fnode = np.zeros_like(state.u)
-    # s where s^2 rho h and b1 / h balance
-    sigma = highest_frequency(disc)
+    sigma = highest_frequency(disc)  # s where s^2 rho h and b1 / h balance
     J = []
     for s in (sigma, 2.0 * sigma, 3.0 * sigma):
-        assemble(state.u.copy(), state.theta.copy(), state.lam.copy(), state.g.copy(), fnode,
-                 old, s, 0.0, disc.mesh, p, drive, disc.loads, w, True)
-        if is_exact(p.law):
-            c = state.g[0] if disc.closed else p.speed
-            add_stick_penalty(w, s, p.friction_scale, c, disc.mesh, p)
+        w, _ = _assembled(disc, state, s)
         J.append(jacobian_matrix(w, disc.closed))
     second = (J[2] - 2.0 * J[1] + J[0]) / 2.0
     first = J[1] - J[0] - 3.0 * second
@@ -104,6 +90,53 @@ def linearisation(disc, state):
     return tuple(_clean(part / scale, zero / scale)
                  for part, scale in ((second, sigma * sigma), (first, sigma),
                                      (J[0] - first - second, 1.0)))
+
+
+def _assembled(disc, state, s):
+    """The kernel's workspace assembled about the steady ``state`` at step rate s (the
+    primal form, the scene's own damping, an exact law's stuck nodes with their penalty
+    slope), and the model's parameters it took."""
+    P = disc.params
+    # the primal form: the Jacobian is then the residual's whole derivative
+    p = disc.model._replace(damping=P.damping, dual=0)
+    old = state._replace(ud=np.zeros_like(state.ud), td=np.zeros_like(state.td),
+                         gd=np.zeros_like(state.gd))
+    w = Workspace.allocate(disc.grid.n_elements, is_exact(p.law), disc.closed,
+                           disc.n_globals)
+    assemble(state.u.copy(), state.theta.copy(), state.lam.copy(), state.g.copy(),
+             np.zeros_like(state.u), old, s, 0.0, disc.mesh, p, disc.steady_drive(),
+             disc.loads, w, True)
+    if is_exact(p.law):
+        c = state.g[0] if disc.closed else p.speed
+        add_stick_penalty(w, s, p.friction_scale, c, disc.mesh, p)
+    return w, p
+
+
+def driver_forcing(disc, state) -> np.ndarray:
+    """-dR/d(omega_d): the linearised loop's forcing per unit of the driver's speed
+    (rad/s), over the unknowns of :func:`linearisation` (a perturbation omega_d + delta
+    e^{i w t} drives (-w^2 M + i w C + K) z = f delta).
+
+    The driver's speed enters only the slip velocity of its arc's nodes, as -r_d omega_d:
+    a node's force F_j = -k_j v_rel,j (k_j its friction slope: a regularised law's, or an
+    exact law's stuck node's penalty, as the linearisation has them) gives its axial row
+    -k_j r_d and its rotation row, times the lever of its face.
+    """
+    if not disc.closed:
+        raise ValueError("driver_forcing: a closed drive's (an open layout has no driver)")
+    w, p = _assembled(disc, state, 1.0)
+    mesh, P = disc.mesh, disc.params
+    n, b = w.Db.shape[0], w.Db.shape[1]
+    out = np.zeros(b * n + disc.n_globals)
+    r = P.pulleys[P.driver].radius
+    driver_segment = int(np.flatnonzero(disc.speed_global < 0)[0])
+    for j in mesh.cn:
+        if mesh.seg[j] != driver_segment:
+            continue
+        k = mesh.wf[j] * w.bs[j] * w.sg[j] / p.regularisation
+        out[b * j] = k * r
+        out[b * j + 1] = p.half_height * mesh.face[j] * k * r
+    return out
 
 
 def _clean(A, zero) -> sp.csr_matrix:
