@@ -88,6 +88,15 @@ SERPENTINE_PULLEYS = [
 ]
 
 
+#: A three-pulley machine drive with a back-side idler on its tight span (as the shipped
+#: serpentine_machine's layout).
+BACK_IDLER = [
+    {"name": "motor", "centre": [0.0, 0.0], "radius": 0.08, "speed": 150.0},
+    {"name": "mill", "centre": [0.6, 0.0], "radius": 0.12, "inertia": 0.02,
+     "load_torque": 30.0},
+    {"name": "idler", "centre": [0.16, 0.075], "radius": 0.035, "side": "back",
+     "inertia": 1e-4},
+]
 #: SERPENTINE_PULLEYS with a back-side idler pressing on the motor-mill span from outside
 #: the loop: the kernels' N-pulley layout (the friction on the belt's outer face there).
 SERPENTINE_BACK = [SERPENTINE_PULLEYS[0],

@@ -14,16 +14,7 @@ from beltsim.beltdrive.exact import string_state
 from beltsim.errors import SceneError
 from beltsim.simulation.controller import run
 from beltsim.solvers import discretise
-from helpers import SERPENTINE_PULLEYS, serpentine_scene
-
-#: A three-pulley drive with a back-side idler on the tight span.
-BACK_IDLER = [
-    {"name": "motor", "centre": [0.0, 0.0], "radius": 0.08, "speed": 150.0},
-    {"name": "mill", "centre": [0.6, 0.0], "radius": 0.12, "inertia": 0.02,
-     "load_torque": 30.0},
-    {"name": "idler", "centre": [0.16, 0.075], "radius": 0.035, "side": "back",
-     "inertia": 1e-4},
-]
+from helpers import BACK_IDLER, SERPENTINE_PULLEYS, serpentine_scene
 
 
 def solve_steady(scene, elements=None):

@@ -17,16 +17,8 @@ from beltsim.beltdrive.rotational import adhesion_limit, rotational_model, stiff
 from beltsim.errors import SceneError, UsageError
 from beltsim.physics import modes as linear
 from beltsim.physics.loop_modes import drive_modes
-from helpers import cli, serpentine_scene
+from helpers import BACK_IDLER, cli, serpentine_scene
 
-#: Three pulleys with a back-side idler on the tight span (test_serpentine's layout)
-BACK_IDLER = [
-    {"name": "motor", "centre": [0.0, 0.0], "radius": 0.08, "speed": 150.0},
-    {"name": "mill", "centre": [0.6, 0.0], "radius": 0.12, "inertia": 0.02,
-     "load_torque": 30.0},
-    {"name": "idler", "centre": [0.16, 0.075], "radius": 0.035, "side": "back",
-     "inertia": 1e-4},
-]
 #: The limit's grid (the stuck arcs' belt moves with the pulleys whatever the grid: 200
 #: elements give the same frequencies within 2.5e-4)
 LIMIT_ELEMENTS = 100

@@ -24,7 +24,7 @@ from beltsim.beltdrive.plots import draw_drive, plot_drive_history, plot_loop_fi
 from beltsim.cli import main
 from beltsim.io.results import save_run
 from beltsim.plots.common import offscreen
-from helpers import scene_path, serpentine_scene
+from helpers import BACK_IDLER, scene_path, serpentine_scene
 
 matplotlib.use("Agg")
 
@@ -33,15 +33,6 @@ pytestmark = pytest.mark.unit
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 #: nodes per unit of loop length (1/m): about 120 on drive_flat, 110 on the accessory drive
 NODES_PER_M = 60.0
-#: A three-pulley drive with a back-side idler on its tight span (the string model; as
-#: tests/test_serpentine.py's), for a short run on a coarse grid.
-BACK_IDLER = [
-    {"name": "motor", "centre": [0.0, 0.0], "radius": 0.08, "speed": 150.0},
-    {"name": "mill", "centre": [0.6, 0.0], "radius": 0.12, "inertia": 0.02,
-     "load_torque": 30.0},
-    {"name": "idler", "centre": [0.16, 0.075], "radius": 0.035, "side": "back",
-     "inertia": 1e-4},
-]
 
 
 def _state(name):

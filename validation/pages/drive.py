@@ -16,7 +16,7 @@ from beltsim.simulation.result import RunStatus
 from beltsim.solvers.settings import LOOP_ELEMENTS as DEFAULT_ELEMENTS
 from beltsim.solvers.settings import LOOP_TIME_TOLS
 
-from .kit import Page, fmt, num
+from .kit import Page, fmt, num, observed_orders
 
 TITLE = "The closed belt drive"
 SCENE = "drive_flat"
@@ -137,12 +137,10 @@ def ladder(page: Page, quick: bool, beam: bool = False) -> list[dict]:
         if key in EXACT_KEYS:
             continue
         e = np.abs([r["errors"][key] for r in rows])
-        ok = e > 0
-        if ok.sum() < 2:
+        pairs, fit = observed_orders(h, e)
+        if fit is None:
             body.append([title, "", "too few nonzero errors"])
             continue
-        pairs = np.log(e[:-1] / e[1:]) / np.log(h[:-1] / h[1:])
-        fit = float(np.polyfit(np.log(h[ok]), np.log(e[ok]), 1)[0])
         cell = f"{fit:.2f}"
         if key in order_keys and not fit >= MIN_ORDER:
             cell = page.fail(f"steady ladder, {title}: fitted order {fit:.2f} < {MIN_ORDER:g}")

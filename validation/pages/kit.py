@@ -248,3 +248,18 @@ def write_index(out: Path, title: str, intro: str, pages, command: str, sha: str
 
 def log(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
+
+
+def observed_orders(h, e):
+    """The observed orders of errors ``e`` over element sizes ``h``: log(e1 / e2) /
+    log(h1 / h2) for each successive pair, and the least-squares slope of log abs(e)
+    against log h over the nonzero errors (None with fewer than two)."""
+    import numpy as np
+
+    h, e = np.asarray(h, dtype=float), np.abs(np.asarray(e, dtype=float))
+    ok = e > 0
+    if ok.sum() < 2:
+        return None, None
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pairs = np.log(e[:-1] / e[1:]) / np.log(h[:-1] / h[1:])
+    return pairs, float(np.polyfit(np.log(h[ok]), np.log(e[ok]), 1)[0])

@@ -15,7 +15,7 @@ from beltsim.beltdrive import GrossSlipError, string_state
 from beltsim.physics.layout import LoopGrid
 from beltsim.solvers.settings import LOOP_ELEMENTS as DEFAULT_ELEMENTS
 
-from .kit import Page, fmt, num
+from .kit import Page, fmt, num, observed_orders
 
 TITLE = "Serpentine drives"
 #: the shipped scenes: seven pulleys with two back-side idlers; three with one; the
@@ -61,13 +61,10 @@ def _orders(page: Page, name: str, rows, quick: bool) -> list[list[str]]:
     for key, title in ERRORS.items():
         if rows[0]["errors"].get(key) is None:
             continue
-        e = np.abs([r["errors"][key] for r in rows])
-        ok = e > 0
-        if ok.sum() < 2:
+        pairs, fit = observed_orders(h, [r["errors"][key] for r in rows])
+        if fit is None:
             body.append([name, title, "", "too few nonzero errors"])
             continue
-        pairs = np.log(e[:-1] / e[1:]) / np.log(h[:-1] / h[1:])
-        fit = float(np.polyfit(np.log(h[ok]), np.log(e[ok]), 1)[0])
         cell = f"{fit:.2f}"
         if key in ORDER_KEYS and not fit >= floor:
             cell = page.fail(f"{name}, {title}: fitted order {fit:.2f} < {floor:g}")

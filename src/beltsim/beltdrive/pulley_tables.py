@@ -109,6 +109,21 @@ class PulleySpec:
         return 0.0 if self.load is None else float(final_value(self.load))
 
 
+def checked_keys(table: dict, rules: dict, required, prefix: str, section: str) -> dict:
+    """A table's keys checked by their rules (named ``PREFIX.KEY``), the required ones
+    present; the first broken rule raises SceneError naming its key."""
+    clean = {}
+    for key, value in table.items():
+        if key not in rules:
+            raise SceneError(f"{prefix}.{key}", f"unknown key (known in {section}: "
+                             f"{', '.join(rules)})")
+        clean[key] = rules[key].check(f"{prefix}.{key}", value)
+    for key in required:
+        if key not in clean:
+            raise SceneError(f"{prefix}.{key}", "missing key")
+    return clean
+
+
 def check_pulleys(raw, contact: dict) -> list[dict]:
     """The ``[[pulley]]`` tables checked key by key, normalised (``side`` filled in).
 
@@ -135,15 +150,8 @@ def check_pulleys(raw, contact: dict) -> list[dict]:
             raise SceneError(f"pulley.{name}.name", "a second pulley of this name: names "
                              "must be unique")
         names.add(name)
-        clean = {}
-        for key, value in table.items():
-            if key not in PULLEY_RULES:
-                raise SceneError(f"pulley.{name}.{key}", f"unknown key (known in [[pulley]]: "
-                                 f"{', '.join(PULLEY_RULES)})")
-            clean[key] = PULLEY_RULES[key].check(f"pulley.{name}.{key}", value)
-        for key in PULLEY_REQUIRED:
-            if key not in clean:
-                raise SceneError(f"pulley.{name}.{key}", "missing key")
+        clean = checked_keys(table, PULLEY_RULES, PULLEY_REQUIRED, f"pulley.{name}",
+                             "[[pulley]]")
         clean.setdefault("side", "inner")
         if "speed" in clean and "load_torque" in clean:
             raise SceneError(f"pulley.{name}.load_torque", "not on the driver (the pulley "

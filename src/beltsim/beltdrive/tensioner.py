@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import NoSolutionError, SceneError
 from ..problem.rules import Rule, show
-from .pulley_tables import CentreRule
+from .pulley_tables import CentreRule, checked_keys
 from .pulleys import GeometryError, PulleyLayout
 
 
@@ -213,15 +213,8 @@ def check_tensioner(table, pulleys) -> dict:
     if pulleys is None:
         raise SceneError("[tensioner]", "only in a scene with [[pulley]] tables (the "
                          "two-pulley shorthand has no idler to put on an arm)")
-    clean = {}
-    for key, value in table.items():
-        if key not in TENSIONER_RULES:
-            raise SceneError(f"tensioner.{key}", f"unknown key (known in [tensioner]: "
-                             f"{', '.join(TENSIONER_RULES)})")
-        clean[key] = TENSIONER_RULES[key].check(f"tensioner.{key}", value)
-    for key in TENSIONER_REQUIRED:
-        if key not in clean:
-            raise SceneError(f"tensioner.{key}", "missing key")
+    clean = checked_keys(table, TENSIONER_RULES, TENSIONER_REQUIRED, "tensioner",
+                         "[tensioner]")
     names = [p["name"] for p in pulleys]
     if clean["pulley"] not in names:
         raise SceneError("tensioner.pulley", f"must name one of the pulleys "
