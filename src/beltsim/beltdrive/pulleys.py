@@ -203,7 +203,7 @@ class PulleyLayout:
     ----------
     pulleys : sequence of Pulley
         In material order: span j runs from pulley j to pulley j + 1 (mod N). Either
-        sense of listing is accepted; :attr:`sense` tells which it is.
+        sense of listing is accepted; ``sense`` tells which it is.
     sense : {None, 1, -1}
         None (default) finds the sense in which the pulleys make a belt loop, trying
         first the sense of the polygon of the inner pulleys' centres (counterclockwise
