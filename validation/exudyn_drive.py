@@ -115,8 +115,11 @@ def span_lines(curve):
 
 
 def run_exudyn(t_end: float, omega: float, ramp: float, load_torque: float,
-               window: float, sample_dt: float, trace_dt: float = 0.1) -> dict:
-    """Build and run the Exudyn model; means over the last ``window`` seconds."""
+               window: float, sample_dt: float, trace_dt: float = 0.1,
+               friction_stiffness: float = FRICTION_STIFFNESS) -> dict:
+    """Build and run the Exudyn model; means over the last ``window`` seconds.
+    ``friction_stiffness``: the tangential penalty of sticking (the example's by
+    default), its velocity penalty kept in the example's ratio 1e-4 s."""
     import copy
 
     import exudyn as exu
@@ -210,8 +213,9 @@ def run_exudyn(t_end: float, omega: float, ramp: float, load_torque: float,
                 markerNumbers=[mWheel, mCable], nodeNumber=nData,
                 numberOfContactSegments=N_SEGMENTS, contactStiffness=CONTACT_STIFFNESS,
                 contactDamping=CONTACT_DAMPING,
-                frictionVelocityPenalty=FRICTION_VELOCITY_PENALTY,
-                frictionStiffness=FRICTION_STIFFNESS, frictionCoefficient=MU,
+                frictionVelocityPenalty=FRICTION_VELOCITY_PENALTY
+                * friction_stiffness / FRICTION_STIFFNESS,
+                frictionStiffness=friction_stiffness, frictionCoefficient=MU,
                 circleRadius=r))
             contacts[name].append((co, nData, element_lengths[k] / N_SEGMENTS))
 
@@ -323,7 +327,7 @@ def run_exudyn(t_end: float, omega: float, ramp: float, load_torque: float,
     for items in contacts.values():
         for co, _, _ in items:
             mbs.SetObjectParameter(co, "frictionCoefficient", MU)
-            mbs.SetObjectParameter(co, "frictionStiffness", FRICTION_STIFFNESS)
+            mbs.SetObjectParameter(co, "frictionStiffness", friction_stiffness)
     mbs.SetObjectParameter(driver_constraint, "activeConnector", True)
     for c in locks:
         mbs.SetObjectParameter(c, "activeConnector", False)
@@ -344,6 +348,7 @@ def run_exudyn(t_end: float, omega: float, ramp: float, load_torque: float,
         "t_end": t_end, "step": STEP, "steps": ss.timeIntegration.numberOfSteps,
         "omega": omega, "ramp": ramp, "ramp_kind": "C2 smoothstep, offsetUserFunction_t",
         "load_torque": load_torque, "window": window, "samples": len(samples),
+        "friction_stiffness": friction_stiffness, "contact_stiffness": CONTACT_STIFFNESS,
         "reference_length": loop_length, "pre_stretch": PRE_STRETCH,
         "wall_static": wall_static, "wall_dynamic": wall_dynamic,
         "static": static,
@@ -370,9 +375,12 @@ def exudyn_main(argv) -> int:
     p.add_argument("--load-torque", type=float, default=1.5)
     p.add_argument("--window", type=float, default=2.0)
     p.add_argument("--sample-dt", type=float, default=0.05)
+    p.add_argument("--friction-stiffness", type=float, default=FRICTION_STIFFNESS,
+                   help="the tangential penalty of sticking (N/m per segment)")
     p.add_argument("--json", type=Path, required=True)
     a = p.parse_args(argv)
-    res = run_exudyn(a.t_end, a.omega, a.ramp, a.load_torque, a.window, a.sample_dt)
+    res = run_exudyn(a.t_end, a.omega, a.ramp, a.load_torque, a.window, a.sample_dt,
+                     friction_stiffness=a.friction_stiffness)
     a.json.parent.mkdir(parents=True, exist_ok=True)
     a.json.write_text(json.dumps(res, indent=1))
     print(f"exudyn: {a.t_end} s simulated in {res['wall_dynamic']:.1f} s of wall time "
@@ -403,9 +411,10 @@ def _table(summary: dict) -> dict:
 
 
 def run_beltsim(reference_length: float, startup: bool, omega: float, ramp: float,
-                load_torque: float) -> dict:
+                load_torque: float, static_tension: float) -> dict:
     """beltsim's creep theory and steady solve of the scene (and, with ``startup``, a
-    start-up from rest by esdirk3 with Exudyn's ramp); the theory on the rims too."""
+    start-up from rest by esdirk3 with Exudyn's ramp); the theory on the rims too, and
+    with the belt installed at ``static_tension`` (Exudyn's, from its static solve)."""
     import beltsim
     from beltsim.beltdrive import string_state
 
@@ -429,6 +438,11 @@ def run_beltsim(reference_length: float, startup: bool, omega: float, ramp: floa
         SCENE, overrides=base + rims + [f"drive.installation_tension={n0_rims!r}"])
     out["theory_rims"] = _table(string_state(rim_scene.params).summary())
     out["theory_rims"]["installation_tension"] = n0_rims
+
+    at_static = beltsim.load_scene(
+        SCENE, overrides=base + [f"drive.installation_tension={static_tension!r}"])
+    out["theory_static"] = _table(string_state(at_static.params).summary())
+    out["theory_static"]["installation_tension"] = static_tension
 
     t0 = time.perf_counter()
     steady = beltsim.run(scene)
@@ -474,8 +488,10 @@ def exudyn_table(exu: dict) -> dict:
 def comparison_rows(bs: dict, ex: dict):
     """(quantity, unit, {column: value}) rows of the comparison."""
     n0_rims = bs["theory_rims"]["installation_tension"]
+    n0_static = bs["theory_static"]["installation_tension"]
     cols = {f"theory on the rims, N0 = {n0_rims:.1f} N": bs["theory_rims"],
-            "beltsim theory": bs["theory"], "beltsim steady": bs["steady"]}
+            "beltsim theory": bs["theory"], "beltsim steady": bs["steady"],
+            f"theory, N0 = Exudyn's static {n0_static:.2f} N": bs["theory_static"]}
     if "startup" in bs:
         cols["beltsim start-up"] = bs["startup"]
     cols["Exudyn"] = ex
@@ -508,6 +524,30 @@ def markdown_table(rows) -> str:
     return "\n".join(lines)
 
 
+def steadiness(exu: dict) -> str:
+    """How steady Exudyn's window is: each figure's standard deviation over the window and
+    the change of its mean from the window's first half to its second."""
+    hist = exu["history"]
+    half = len(hist) // 2
+
+    def drift(get):
+        a = sum(get(h) for h in hist[:half]) / half
+        b = sum(get(h) for h in hist[half:]) / (len(hist) - half)
+        return b - a
+
+    lines = [f"Exudyn over its last {exu['window']:g} s: standard deviation, drift "
+             "(second half's mean less the first half's)"]
+    for b, e in SPANS:
+        lines.append(f"  tension {b}: {exu['tension_std'][e]:.3g} N, "
+                     f"{drift(lambda h, e=e: h['tension'][e]):+.3g} N")
+    ratio = [h["speed"]["driven"] / h["speed"]["driver"] for h in hist]
+    mean = sum(ratio) / len(ratio)
+    std = (sum((r - mean) ** 2 for r in ratio) / len(ratio)) ** 0.5
+    lines.append(f"  speed ratio: {std:.2g}, "
+                 f"{drift(lambda h: h['speed']['driven'] / h['speed']['driver']):+.2g}")
+    return "\n".join(lines)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m validation.exudyn_drive",
                                 description="Cross-check beltsim against Exudyn on the "
@@ -522,6 +562,9 @@ def main(argv=None) -> int:
     p.add_argument("--omega", type=float, default=2 * math.pi, help="driver speed (rad/s)")
     p.add_argument("--ramp", type=float, default=1.0, help="smoothstep ramp time (s)")
     p.add_argument("--load-torque", type=float, default=1.5, help="driven load (N m)")
+    p.add_argument("--friction-stiffness", type=float, default=FRICTION_STIFFNESS,
+                   help="Exudyn's tangential penalty of sticking (N/m per segment; "
+                        "the example's 8000 by default)")
     p.add_argument("--no-startup", action="store_true", help="skip beltsim's start-up run")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT)
     a = p.parse_args(argv)
@@ -532,6 +575,7 @@ def main(argv=None) -> int:
         cmd = [a.exudyn_python or sys.executable, str(Path(__file__).resolve()), "exudyn",
                "--t-end", repr(a.t_end), "--window", repr(a.window), "--omega", repr(a.omega),
                "--ramp", repr(a.ramp), "--load-torque", repr(a.load_torque),
+               "--friction-stiffness", repr(a.friction_stiffness),
                "--json", str(a.exudyn_json)]
         print("running Exudyn:", " ".join(cmd), flush=True)
         subprocess.run(cmd, check=True)
@@ -540,18 +584,21 @@ def main(argv=None) -> int:
         if abs(exu[key] - mine) > 1e-12:
             raise SystemExit(f"{a.exudyn_json}: Exudyn ran with {key} = {exu[key]}, not {mine}")
 
+    static = exu["static"]["tension"]
     bs = run_beltsim(exu["reference_length"], not a.no_startup, a.omega, a.ramp,
-                     a.load_torque)
+                     a.load_torque, sum(static.values()) / len(static))
     ex = exudyn_table(exu)
     rows = comparison_rows(bs, ex)
     print(f"Exudyn {exu['exudyn_version']}: {exu['t_end']:g} s simulated in "
           f"{exu['steps']} steps of {exu['step'] * 1e3:g} ms, means over the last "
-          f"{exu['window']:g} s ({exu['samples']} samples)")
+          f"{exu['window']:g} s ({exu['samples']} samples); friction stiffness "
+          f"{exu.get('friction_stiffness', FRICTION_STIFFNESS):g} N/m per segment")
     print(f"installation tension: beltsim {bs['installation_tension']:.3f} N on the middle "
           f"line's loop ({bs['loop_length']:.5f} m); Exudyn's static solve "
           f"{min(exu['static']['tension'].values()):.3f} .. "
           f"{max(exu['static']['tension'].values()):.3f} N")
     print(markdown_table(rows))
+    print(steadiness(exu))
     # beltsim's runs: the run's own stepping time (result.wall_time), without compiling
     # or loading the numba kernels (compile_time, printed below)
     walls = {"beltsim theory": bs["theory"]["wall"],
