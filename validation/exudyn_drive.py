@@ -22,6 +22,8 @@ reference axial strain -0.005, axial damping 1e-2 EA, two contact segments per e
 and pulley (contact stiffness 4e4, friction stiffness 8e3, velocity penalty 0.8),
 mu = 0.2, 1 kg / 0.01 kg m^2 pulleys, generalised-alpha with spectral radius 0.5 and
 steps of 0.25 ms, a static solve without friction and with the pulleys locked first.
+It runs 8 s (``--t-end``) and reports means over the last 2 s (``--window``); the
+results and what they mean are on docs/verification/exudyn.md.
 
 Run it from the repository root with beltsim's interpreter; Exudyn may live elsewhere::
 
