@@ -13,7 +13,11 @@ line of JSON (:func:`bench`'s dict):
   the cost's growth with the grid);
 * one Newton iteration's pieces on each of those grids, at the creep theory's state (the
   steady Newton's start): the residual with its Jacobian (numba), the bordered block-band
-  factorisation with its solve, and the start itself.
+  factorisation with its solve, and the start itself;
+* with ``--peers``, generic peers on the same grid (:mod:`benchmarks.drive_peers`: Newton
+  with a sparse finite-difference Jacobian and spsolve, scipy.optimize.root, BDF2 steps
+  with splu, all on the numpy reference of the kernel's residual), each stopped at
+  ``--peer-cap`` seconds, in a table against our steady scheme and our start-up.
 
 Each wall time is the shortest of ``--repeat`` calls with the kernels loaded.
 """
@@ -206,8 +210,82 @@ def iteration_cost(scene, elements=None) -> dict:
     return out
 
 
-def bench(scene, repeat: int = 3, elements=None, grids=GRID_FACTORS, kernels=True) -> dict:
-    """Every figure of the module's docstring, as a dict."""
+#: the generic peers of ``--peers`` (benchmarks.drive_peers), by key
+PEERS = ("newton", "krylov", "hybr", "bdf2")
+
+
+def peers(scene, steady_out: dict, ours, start_out: dict, cap: float,
+          which=PEERS) -> dict:
+    """The generic peers of :mod:`benchmarks.drive_peers` on our steady run's grid, each
+    capped at ``cap`` s, against our steady scheme (``steady_out``, its result ``ours``)
+    or our start-up (``start_out``); prints their table."""
+    from beltsim.simulation.controller import Simulation
+    from beltsim.solvers import LoopDiscretisation
+
+    from . import drive_peers as dp
+
+    elements = steady_out["elements"]
+    base = scene.with_overrides({"numerics.elements": elements})
+    d = LoopDiscretisation(base.with_overrides({"numerics.integrator": "steady"}))
+    state = ours.solution.state
+    rows = []
+    for key in which:
+        log(f"peer {key} ({elements} elements, cap {cap:g} s) ...")
+        if key == "newton":
+            res = dp.run_newton_peer(d, cap=cap)
+        elif key in ("krylov", "hybr"):
+            res = dp.run_root_peer(d, key, cap=cap)
+        elif key == "bdf2":
+            res = dp.run_bdf2_peer(Simulation(base), cap=cap)
+        else:
+            raise ValueError(f"unknown peer {key!r}")
+        start = key == "bdf2"
+        diff = dp.difference(d, res.state, state)
+        same = dp.SAME_RUN if start else dp.SAME_STEADY
+        reached = res.converged and diff <= same
+        base_solve = (start_out["solve_wall_time"] if start
+                      else steady_out["solve_wall_time"])
+        rows.append({"peer": key, "name": res.name, "against":
+                     "start-up (default run)" if start else "steady scheme",
+                     "wall_time": res.wall_time, "converged": res.converged,
+                     "reason": res.reason, "reached": reached, "difference": diff,
+                     "tolerance": same, "ours_solve": base_solve,
+                     "ratio": res.wall_time / base_solve,
+                     "simulated_time": res.simulated_time, "statistics": res.statistics})
+        log(f"  {res.name}: {res.reason}, wall {res.wall_time:.4g} s, difference "
+            f"{diff:.2e}, its wall over our solve {res.wall_time / base_solve:.3g}"
+            f"{'' if reached else ' (did NOT reach our state)'}")
+    table(steady_out, start_out, rows)
+    return {"elements": elements, "cap": cap, "rows": rows}
+
+
+def table(steady_out: dict, start_out: dict, rows) -> None:
+    """The peers' table, ours first (plain text)."""
+    head = ("method", "against", "call [s]", "solve [s]", "its solve over ours",
+            "reached our state", "largest difference")
+    lines = [("ours: steady scheme", "", f"{steady_out['wall_time']:.4g}",
+              f"{steady_out['solve_wall_time']:.4g}", "1", "yes", ""),
+             (f"ours: start-up ({start_out['integrator']})", "",
+              f"{start_out['wall_time']:.4g}", f"{start_out['solve_wall_time']:.4g}", "1",
+              "yes" if start_out["converged"] else "no",
+              f"{start_out['difference']:.2e}" if start_out["difference"] is not None
+              else "")]
+    for r in rows:
+        ratio = f"{r['ratio']:.3g}" if r["reached"] else f">= {r['ratio']:.3g}"
+        why = "yes" if r["reached"] else (
+            f"no: {r['reason']}" if not r["converged"]
+            else f"no: {r['difference']:.1e} > {r['tolerance']:g}")
+        lines.append((r["name"], r["against"], f"{r['wall_time']:.4g}",
+                      f"{r['wall_time']:.4g}", ratio, why, f"{r['difference']:.2e}"))
+    widths = [max(len(x[i]) for x in (head, *lines)) for i in range(len(head))]
+    for line in (head, tuple("-" * w for w in widths), *lines):
+        log(" | ".join(x.ljust(w) for x, w in zip(line, widths)))
+
+
+def bench(scene, repeat: int = 3, elements=None, grids=GRID_FACTORS, kernels=True,
+          peer_cap=None, which=PEERS) -> dict:
+    """Every figure of the module's docstring, as a dict; with ``peer_cap`` (s), the
+    peers too."""
     out = {"kernels": None}
     if kernels:
         out["kernels"] = {"compile_s": kernel_time(scene, True),
@@ -224,6 +302,8 @@ def bench(scene, repeat: int = 3, elements=None, grids=GRID_FACTORS, kernels=Tru
     out["iteration"] = [iteration_cost(scene, e["elements"]) for e in out["steady"]
                         if e.get("elements")]
     out["start_up"] = start_up(scene, repeat, ref.solution.summary(), base)
+    if peer_cap is not None:
+        out["peers"] = peers(scene, first, ref, out["start_up"], peer_cap, which)
     return _plain(out)
 
 
@@ -239,6 +319,11 @@ def main(argv=None) -> int:
     p.add_argument("--grids", default=",".join(map(str, GRID_FACTORS)),
                    help="comma-separated factors of finer grids for the steady scheme")
     p.add_argument("--no-kernels", action="store_true", help="skip compile and load times")
+    p.add_argument("--peers", nargs="?", const=",".join(PEERS), default=None,
+                   help="run the generic peers (benchmarks.drive_peers) on the grid: all, "
+                        f"or a comma-separated choice of {', '.join(PEERS)}")
+    p.add_argument("--peer-cap", type=float, default=300.0,
+                   help="each peer's wall-time cap in s (default 300)")
     p.add_argument("--json", default=None, help="also write the dict to this file")
     args = p.parse_args(argv)
     if args.repeat < 1:
@@ -247,8 +332,15 @@ def main(argv=None) -> int:
         grids = tuple(int(g) for g in args.grids.split(",") if g)
     except ValueError:
         p.error(f"--grids: expected comma-separated whole numbers, got {args.grids!r}")
+    which = PEERS
+    if args.peers is not None:
+        which = tuple(k for k in args.peers.split(",") if k)
+        bad = [k for k in which if k not in PEERS]
+        if bad:
+            p.error(f"--peers: unknown {', '.join(bad)} (choose from {', '.join(PEERS)})")
     out = bench(load_scene(args.scene), args.repeat, args.elements, grids,
-                kernels=not args.no_kernels)
+                kernels=not args.no_kernels,
+                peer_cap=args.peer_cap if args.peers is not None else None, which=which)
     text = json.dumps(out)
     if args.json:
         with open(args.json, "w", encoding="utf-8") as fh:
