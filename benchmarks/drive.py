@@ -94,8 +94,17 @@ def _shortest(fn, repeat):
 
 
 def difference(summary: dict, reference: dict) -> float:
-    """The largest relative difference of the KEYS (the speed ratio as the speed loss)."""
+    """The largest relative difference of the KEYS (the speed ratio as the speed loss); a
+    drive of more than two pulleys (no two-pulley KEYS): of the belt's speed, each span's
+    tension and each pulley's speed."""
     out = 0.0
+    if "tight_tension" not in reference:
+        pairs = [(summary["belt_speed"], reference["belt_speed"])]
+        pairs += [(a["tension"], b["tension"])
+                  for a, b in zip(summary["spans"], reference["spans"])]
+        pairs += [(a["speed"], b["speed"])
+                  for a, b in zip(summary["pulleys"], reference["pulleys"])]
+        return max(abs(a - b) / max(abs(b), 1e-300) for a, b in pairs)
     for k in KEYS:
         a, b = summary[k], reference[k]
         if k == "speed_ratio":
