@@ -14,10 +14,13 @@ line of JSON (:func:`bench`'s dict):
 * one Newton iteration's pieces on each of those grids, at the creep theory's state (the
   steady Newton's start): the residual with its Jacobian (numba), the bordered block-band
   factorisation with its solve, and the start itself;
-* with ``--peers``, generic peers on the same grid (:mod:`benchmarks.drive_peers`: Newton
-  with a sparse finite-difference Jacobian and spsolve, scipy.optimize.root, BDF2 steps
-  with splu, all on the numpy reference of the kernel's residual), each stopped at
-  ``--peer-cap`` seconds, in a table against our steady scheme and our start-up.
+* with ``--peers [LIST]``, generic peers on the same grid (:mod:`benchmarks.drive_peers`,
+  all on the numpy reference of the kernel's residual): Newton with a sparse
+  finite-difference Jacobian and spsolve, scipy.optimize.root krylov and hybr (against
+  our steady scheme), BDF2 steps with splu (against our start-up); with ``--peers all``
+  also solve_ivp's Radau and BDF on the tanh law's ODE form (against our start-up of the
+  tanh law, timed here). Each is stopped at ``--peer-cap`` seconds; a table of them
+  against ours is printed last before the JSON.
 
 Each wall time is the shortest of ``--repeat`` calls with the kernels loaded.
 """
@@ -222,15 +225,22 @@ def iteration_cost(scene, elements=None) -> dict:
     return out
 
 
-#: the generic peers of ``--peers`` (benchmarks.drive_peers), by key
-PEERS = ("newton", "krylov", "hybr", "bdf2")
+#: the generic peers of ``--peers`` (benchmarks.drive_peers), by key: radau and bdf run
+#: the tanh law (a method-of-lines right-hand side needs a single-valued law)
+PEERS = ("newton", "krylov", "hybr", "bdf2", "radau", "bdf")
+#: those of ``--peers`` without a choice (``--peers all``: every one)
+DEFAULT_PEERS = PEERS[:4]
+#: the ODE peers' rtol
+ODE_RTOL = 1e-3
 
 
 def peers(scene, steady_out: dict, ours, start_out: dict, cap: float,
-          which=PEERS) -> dict:
+          which=PEERS, repeat: int = 1) -> dict:
     """The generic peers of :mod:`benchmarks.drive_peers` on our steady run's grid, each
     capped at ``cap`` s, against our steady scheme (``steady_out``, its result ``ours``)
-    or our start-up (``start_out``); prints their table."""
+    or our start-up (``start_out``); the ODE peers (tanh law) against our run of the tanh
+    law (its start-up, timed here, and its steady state). Prints their table."""
+    import beltsim
     from beltsim.simulation.controller import Simulation
     from beltsim.solvers import LoopDiscretisation
 
@@ -240,25 +250,36 @@ def peers(scene, steady_out: dict, ours, start_out: dict, cap: float,
     base = scene.with_overrides({"numerics.elements": elements})
     d = LoopDiscretisation(base.with_overrides({"numerics.integrator": "steady"}))
     state = ours.solution.state
+    tanh = base.with_overrides({"numerics.friction_law": "tanh"})
+    tanh_out = tanh_state = None
+    if {"radau", "bdf"} & set(which):
+        tanh_steady = beltsim.run(tanh.with_overrides({"numerics.integrator": "steady"}))
+        tanh_state = tanh_steady.solution.state
+        # at least twice: the first run of the tanh law in a process loads its kernels
+        tanh_out = start_up(tanh, max(2, repeat), tanh_steady.solution.summary())
     rows = []
     for key in which:
         log(f"peer {key} ({elements} elements, cap {cap:g} s) ...")
+        ref, against, same = state, "steady scheme", dp.SAME_STEADY
+        base_solve = steady_out["solve_wall_time"]
         if key == "newton":
             res = dp.run_newton_peer(d, cap=cap)
         elif key in ("krylov", "hybr"):
             res = dp.run_root_peer(d, key, cap=cap)
         elif key == "bdf2":
             res = dp.run_bdf2_peer(Simulation(base), cap=cap)
+            against, same = "start-up (default run)", dp.SAME_RUN
+            base_solve = start_out["solve_wall_time"]
+        elif key in ("radau", "bdf"):
+            res = dp.run_ode_peer(Simulation(tanh), "Radau" if key == "radau" else "BDF",
+                                  ODE_RTOL, cap=cap)
+            ref, against, same = tanh_state, "start-up, tanh law", dp.SAME_RUN
+            base_solve = tanh_out["solve_wall_time"]
         else:
             raise ValueError(f"unknown peer {key!r}")
-        start = key == "bdf2"
-        diff = dp.difference(d, res.state, state)
-        same = dp.SAME_RUN if start else dp.SAME_STEADY
+        diff = dp.difference(d, res.state, ref)
         reached = res.converged and diff <= same
-        base_solve = (start_out["solve_wall_time"] if start
-                      else steady_out["solve_wall_time"])
-        rows.append({"peer": key, "name": res.name, "against":
-                     "start-up (default run)" if start else "steady scheme",
+        rows.append({"peer": key, "name": res.name, "against": against,
                      "wall_time": res.wall_time, "converged": res.converged,
                      "reason": res.reason, "reached": reached, "difference": diff,
                      "tolerance": same, "ours_solve": base_solve,
@@ -267,11 +288,11 @@ def peers(scene, steady_out: dict, ours, start_out: dict, cap: float,
         log(f"  {res.name}: {res.reason}, wall {res.wall_time:.4g} s, difference "
             f"{diff:.2e}, its wall over our solve {res.wall_time / base_solve:.3g}"
             f"{'' if reached else ' (did NOT reach our state)'}")
-    table(steady_out, start_out, rows)
-    return {"elements": elements, "cap": cap, "rows": rows}
+    table(steady_out, start_out, rows, tanh_out)
+    return {"elements": elements, "cap": cap, "rows": rows, "start_up_tanh": tanh_out}
 
 
-def table(steady_out: dict, start_out: dict, rows) -> None:
+def table(steady_out: dict, start_out: dict, rows, tanh_out=None) -> None:
     """The peers' table, ours first (plain text)."""
     head = ("method", "against", "call [s]", "solve [s]", "its solve over ours",
             "reached our state", "largest difference")
@@ -282,6 +303,12 @@ def table(steady_out: dict, start_out: dict, rows) -> None:
               "yes" if start_out["converged"] else "no",
               f"{start_out['difference']:.2e}" if start_out["difference"] is not None
               else "")]
+    if tanh_out is not None:
+        lines.append((f"ours: start-up ({tanh_out['integrator']}), tanh law", "",
+                      f"{tanh_out['wall_time']:.4g}", f"{tanh_out['solve_wall_time']:.4g}",
+                      "1", "yes" if tanh_out["converged"] else "no",
+                      f"{tanh_out['difference']:.2e}" if tanh_out["difference"] is not None
+                      else ""))
     for r in rows:
         ratio = f"{r['ratio']:.3g}" if r["reached"] else f">= {r['ratio']:.3g}"
         why = "yes" if r["reached"] else (
@@ -315,7 +342,7 @@ def bench(scene, repeat: int = 3, elements=None, grids=GRID_FACTORS, kernels=Tru
                         if e.get("elements")]
     out["start_up"] = start_up(scene, repeat, ref.solution.summary(), base)
     if peer_cap is not None:
-        out["peers"] = peers(scene, first, ref, out["start_up"], peer_cap, which)
+        out["peers"] = peers(scene, first, ref, out["start_up"], peer_cap, which, repeat)
     return _plain(out)
 
 
@@ -331,9 +358,10 @@ def main(argv=None) -> int:
     p.add_argument("--grids", default=",".join(map(str, GRID_FACTORS)),
                    help="comma-separated factors of finer grids for the steady scheme")
     p.add_argument("--no-kernels", action="store_true", help="skip compile and load times")
-    p.add_argument("--peers", nargs="?", const=",".join(PEERS), default=None,
-                   help="run the generic peers (benchmarks.drive_peers) on the grid: all, "
-                        f"or a comma-separated choice of {', '.join(PEERS)}")
+    p.add_argument("--peers", nargs="?", const=",".join(DEFAULT_PEERS), default=None,
+                   help="run generic peers (benchmarks.drive_peers) on the grid: "
+                        f"{', '.join(DEFAULT_PEERS)} without a value, 'all', or a "
+                        f"comma-separated choice of {', '.join(PEERS)}")
     p.add_argument("--peer-cap", type=float, default=300.0,
                    help="each peer's wall-time cap in s (default 300)")
     p.add_argument("--json", default=None, help="also write the dict to this file")
@@ -346,7 +374,8 @@ def main(argv=None) -> int:
         p.error(f"--grids: expected comma-separated whole numbers, got {args.grids!r}")
     which = PEERS
     if args.peers is not None:
-        which = tuple(k for k in args.peers.split(",") if k)
+        which = PEERS if args.peers == "all" else tuple(k for k in args.peers.split(",")
+                                                        if k)
         bad = [k for k in which if k not in PEERS]
         if bad:
             p.error(f"--peers: unknown {', '.join(bad)} (choose from {', '.join(PEERS)})")

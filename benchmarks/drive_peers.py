@@ -543,3 +543,119 @@ def difference(d, state: State, ours: State) -> float:
     b = LoopSolution(d, ours).span_tensions()
     out = float(np.max(np.abs(a - b) / np.abs(b)))
     return max(out, float(np.max(np.abs(state.g - ours.g) / np.abs(ours.g))))
+
+
+class DriveODE:
+    """The drive's semi-discretisation as y' = f(t, y) for a regularised law (the ratio
+    lam = g(v_rel / v_reg) is then of the state): y = (u, theta, g, u_t, theta_t).
+
+    The reference's residual with the rates as history and zero accelerations (inv_dt
+    = 1, old = (u - u_t, theta - theta_t, rates u_t, theta_t, globals g)) is the forces'
+    imbalance R0; then rho hb (u_tt + c_t) = -R0 (axial rows), I hb theta_tt = -R0
+    (bending rows), J_k omega_k' = -Rg_k (each free pulley), and the gauge (the mean of u
+    stays 0) gives c_t = -sum(R0 axial) / (rho sum hb). c_t enters every axial row: the
+    Jacobian is dense, and scipy's integrators take it by dense differences.
+    """
+
+    def __init__(self, d):
+        p = d.model
+        if is_exact(p.law):
+            raise ValueError("the ODE form needs a regularised friction law")
+        if p.rotary_inertia <= 0.0 or np.any(np.asarray(d.mesh.inertia[1:]) <= 0.0):
+            raise ValueError("the ODE form needs rotary inertia and every free pulley's")
+        self.d, self.p, self.mesh = d, p, d.mesh
+        self.N = N = len(d.mesh.hb)
+        self.ng = ng = d.n_globals
+        self.size = 4 * N + ng
+        self.mu = p.mass * d.mesh.hb
+        self.mt = p.rotary_inertia * d.mesh.hb
+        self.J = np.asarray(d.mesh.inertia[1:ng], float)
+        self.evaluations = 0
+
+    def parts(self, y):
+        N, ng = self.N, self.ng
+        return (y[:N], y[N:2 * N], y[2 * N:2 * N + ng], y[2 * N + ng:3 * N + ng],
+                y[3 * N + ng:])
+
+    def forces(self, t, y, drive=None):
+        """(R, Rg, F) of the reference at zero accelerations."""
+        u, th, g, ud, td = self.parts(y)
+        old = State(u - ud, th - td, np.zeros(self.N), ud, td, np.zeros(self.N), g,
+                    np.zeros(self.ng))
+        return reference.loop_residual(u, th, np.zeros(self.N), g, old, 1.0, t, self.mesh,
+                                       self.p, self.d.drive if drive is None else drive)
+
+    def rhs(self, t, y):
+        self.evaluations += 1
+        R, Rg, _ = self.forces(t, y)
+        N, ng = self.N, self.ng
+        ct = -R[:, 0].sum() / self.mu.sum()
+        out = np.empty(self.size)
+        out[:2 * N] = y[2 * N + ng:]
+        out[2 * N] = ct
+        out[2 * N + 1:2 * N + ng] = -Rg[1:] / self.J
+        out[2 * N + ng:3 * N + ng] = -R[:, 0] / self.mu - ct
+        out[3 * N + ng:] = -R[:, 1] / self.mt
+        return out
+
+    def scale(self) -> np.ndarray:
+        """Each unknown's scale: our Newton's, and for the rates the creep speed (u_t)
+        and it over the loop length (theta_t)."""
+        sc, P = self.d.scales, self.d.params
+        creep = P.driver_rim_speed * P.N0 / P.b1
+        N = self.N
+        return np.concatenate([np.full(N, sc.u), np.full(N, sc.theta), sc.glob,
+                               np.full(N, creep),
+                               np.full(N, creep / self.mesh.loop_length)])
+
+    def state(self, t, y) -> State:
+        u, th, g, ud, td = self.parts(y)
+        _, _, F = self.forces(t, y)
+        gd = self.rhs(t, y)[2 * self.N:2 * self.N + self.ng]
+        return State(u.copy(), th.copy(), np.zeros(self.N), ud.copy(), td.copy(), F, g.copy(),
+                     gd)
+
+
+def run_ode_peer(sim, method: str = "Radau", rtol: float = 1e-3,
+                 cap: float = 300.0) -> PeerResult:
+    """scipy's Radau or BDF (the classes behind ``solve_ivp(method=...)``) from rest on
+    :class:`DriveODE` with scipy's dense finite-difference Jacobian, atol rtol times each
+    unknown's scale; stepped by hand, as ``solve_ivp`` does, only so that our run's steady
+    test (``sim.steady``, at our check times, on the dense output) can stop it."""
+    from scipy.integrate import BDF, Radau
+
+    name = f"solve_ivp {method} (rtol {rtol:g}), tanh law, dense FD Jacobian"
+    start = time.perf_counter()
+    d = sim.disc
+    ode = DriveODE(d)
+    num = d.numerics
+    solver = {"Radau": Radau, "BDF": BDF}[method](
+        ode.rhs, 0.0, np.zeros(ode.size), num.t_end, rtol=rtol, atol=rtol * ode.scale())
+    steady, check = sim.steady, sim.check
+    k, converged, reason, steps, y, t = 1, False, "not steady by t_end", 0, None, 0.0
+    while solver.status == "running":
+        if time.perf_counter() - start > cap:
+            reason = f"stopped at the {cap:g} s cap at t = {solver.t:.4g} s"
+            break
+        solver.step()
+        steps += 1
+        if solver.status == "failed":
+            reason = f"solver failed at t = {solver.t:.4g} s"
+            break
+        if solver.t >= k * check:
+            dense = solver.dense_output()
+            while k * check <= solver.t and not converged:
+                t = k * check
+                y = dense(t)
+                st = ode.state(t, y)
+                converged = steady.update(t, sim.readout.rate(st), sim.readout.monitor(st))
+                k += 1
+            if converged:
+                reason = "steady"
+                break
+    wall = time.perf_counter() - start
+    if not converged:
+        t, y = solver.t, solver.y
+    stats = {"steps": steps, "evaluations": solver.nfev, "jacobians": solver.njev,
+             "factorisations": solver.nlu}
+    return PeerResult(name, wall, converged, reason, ode.state(t, y), stats, t)
