@@ -149,27 +149,37 @@ class LoopProblem:
         return v[cn]
 
     def local(self, x, old, inv_dt, t, drive):
-        """The rows the differences take: the nodes' rows (interleaved), the NCP rows
-        (an exact law), the contact nodes' frictions F; and (Rg, F) as the reference
-        gave them."""
+        """The rows the differences take (all smooth): the nodes' rows (interleaved), the
+        contact nodes' scaled slip velocities v_rel / v_aug (an exact law), their
+        frictions F; and (Rg, F) as the reference gave them."""
         self.evaluations += 1
         u, th, lam, g = self.unpack(x)
         R, Rg, F = reference.loop_residual(u, th, lam, g, old, inv_dt, t, self.mesh,
                                            self.p, drive)
         parts = [R.ravel()]
         if self.exact:
-            s = self.slip_velocity(u, th, g, old, inv_dt, t, drive) / self.p.regularisation
-            lc = lam[self.cn]
-            parts.append(-s if self.p.law == ADHESION
-                         else lc - np.clip(lc + s, -1.0, 1.0))
+            parts.append(self.slip_velocity(u, th, g, old, inv_dt, t, drive)
+                         / self.p.regularisation)
         parts.append(F[self.cn])
         return np.concatenate(parts), Rg, F
+
+    def _ncp(self, x, s):
+        """The exact law's rows lam - proj_[-1, 1](lam + s) (adhesion: -s) and the
+        stuck nodes (where the projection is inside)."""
+        lc = x[2 * self.N:2 * self.N + self.M]
+        if self.p.law == ADHESION:
+            return -s, np.ones(self.M, bool)
+        z = lc + s
+        return lc - np.clip(z, -1.0, 1.0), np.abs(z) < 1.0
 
     def residual(self, x, old, inv_dt, t, drive):
         """The whole residual: the nodes' rows, the NCP rows, the global rows."""
         loc, Rg, _ = self.local(x, old, inv_dt, t, drive)
         self._last = (x.copy(), loc)  # the differences' f0 when the Jacobian is taken here
-        return np.concatenate([loc[:-self.M], Rg])
+        parts = [loc[:2 * self.N]]
+        if self.exact:
+            parts.append(self._ncp(x, loc[2 * self.N:2 * self.N + self.M])[0])
+        return np.concatenate([*parts, Rg])
 
     def _pattern(self):
         """The local rows' dependence on the unknowns (node j's rows on u, theta at
@@ -183,7 +193,7 @@ class LoopProblem:
         r_u, r_t = 2 * np.arange(N), 2 * np.arange(N) + 1
         pos = np.full(N, -1)
         pos[cn] = np.arange(M)
-        r_n = 2 * N + pos[cn]  # the NCP rows (an exact law)
+        r_n = 2 * N + pos[cn]  # the slip velocities' rows (an exact law)
         r_f = 2 * N + nl + pos[cn]  # the frictions' rows
         for o in (-2, -1, 0, 1):
             k = (np.arange(N) + o) % N
@@ -227,6 +237,18 @@ class LoopProblem:
         J = csr_matrix(J)
         N, nl, M = self.N, self.nl, self.M
         dF = J[-M:]
+        rows = [J[:2 * N]]
+        if self.exact:
+            # the projection's generalised derivative (semi-smooth Newton): e_lam - stuck
+            # (e_lam + ds/dx), ds/dx by the differences
+            _, stuck = self._ncp(x, f0[2 * N:2 * N + M])
+            e = csr_matrix((np.ones(M), (np.arange(M), 2 * N + np.arange(M))),
+                           shape=(M, self.size))
+            ds = J[2 * N:2 * N + M]
+            if self.p.law == ADHESION:
+                rows.append(-ds)
+            else:
+                rows.append(e - _diag(stuck) @ (e + ds))
         gauge = csr_matrix((self._gauge, (np.zeros(N, int), np.arange(N))),
                            shape=(1, self.size))
         pulleys = (self._arc @ dF)[1:]
@@ -235,7 +257,7 @@ class LoopProblem:
             gi = 2 * N + nl + np.arange(1, self.ng)
             pulleys = pulleys + csr_matrix((own, (np.arange(self.ng - 1), gi)),
                                            shape=pulleys.shape)
-        return vstack([J[:-M], gauge, pulleys]).tocsc()
+        return vstack([*rows, gauge, pulleys]).tocsc()
 
     def state(self, x, F=None, rates=None) -> State:
         """x as a State (rates zero unless given; fnode F)."""
@@ -246,6 +268,12 @@ class LoopProblem:
         lam_full = lam.copy()
         return State(u.copy(), th.copy(), lam_full, ud, td,
                      np.zeros(N) if F is None else F.copy(), g.copy(), gd)
+
+
+def _diag(mask):
+    from scipy.sparse import diags
+
+    return diags(mask.astype(float)).tocsr()
 
 
 def _csr(data, shape):
@@ -411,7 +439,9 @@ def run_bdf2_peer(sim, cap: float = 300.0, tol: float = BDF2_TOL,
     y_{n-1}) / (a h): the reference's ``old`` holds y~ for u, theta, the globals and the
     rates u_t, theta_t (the first step is backward Euler). Each step: a simplified Newton
     iteration from the quadratic predictor with the Jacobian (differences) factorised
-    once by splu, refreshed (at most twice) when the update does not contract by half;
+    once by splu, refreshed (at most twice) when the update does not contract by half or
+    gives no descent, its steps cut back on the scaled residual norm (a semi-smooth step
+    can cycle between stick and slip);
     the local error 2/7 |y - y_pred| (BDF2's error constant against the predictor's) in
     the scaled max norm of u, theta and the globals; h_new = h min(2, max(0.2, 0.9
     (tol / err)^(1/3))), a step whose error exceeds tol or whose Newton fails is redone
@@ -426,7 +456,7 @@ def run_bdf2_peer(sim, cap: float = 300.0, tol: float = BDF2_TOL,
     prob = LoopProblem(d)
     num = d.numerics
     N, ng, nl = prob.N, prob.ng, prob.nl
-    xs = prob.scale()
+    xs, rs = prob.scale(), prob.row_scale()
     err_mask = np.ones(prob.size, bool)
     err_mask[2 * N:2 * N + nl] = False  # the ratios jump at stick/slip: not in the error
     x = prob.pack(d.new_state())
@@ -476,20 +506,39 @@ def run_bdf2_peer(sim, cap: float = 300.0, tol: float = BDF2_TOL,
                         li *= (t1 - tm) / (ti - tm)
                 pred += li * xi
             y = pred.copy()
-            ok, refreshes, last = False, 0, math.inf
+            ok, refreshes, last, fresh = False, 0, math.inf, False
+            r = prob.residual(y, old, a, t1, d.drive)
+            merit = float(np.sum((r / rs) ** 2))
             for it in range(3 * max_newton):
-                r = prob.residual(y, old, a, t1, d.drive)
                 if lu is None:
-                    lu = splu(prob.jacobian(y, old, a, t1, d.drive))
                     stats["jacobians"] += 1
-                    last = math.inf
+                    try:
+                        lu = splu(prob.jacobian(y, old, a, t1, d.drive))
+                    except RuntimeError:  # "Factor is exactly singular": a smaller step
+                        stats["singular"] = stats.get("singular", 0) + 1
+                        break
+                    last, fresh = math.inf, True
                 dy = lu.solve(-r)
                 stats["newton_iterations"] += 1
-                y += dy
-                step = float(np.abs(dy / xs).max())
-                if not np.isfinite(step):
+                if not np.all(np.isfinite(dy)):
                     break
-                if step < num.newton_tol * 1e3 or (step < 1e-6 and step < 0.1 * last):
+                # backtracking on the scaled residual norm (semi-smooth steps can cycle)
+                lam_ = 1.0
+                while True:
+                    trial = y + lam_ * dy
+                    r_try = prob.residual(trial, old, a, t1, d.drive)
+                    m_try = float(np.sum((r_try / rs) ** 2))
+                    if m_try <= (1.0 - 1e-4 * lam_) * merit or lam_ < 1.0 / 128:
+                        break
+                    lam_ *= 0.5
+                if lam_ < 1.0 / 128 and m_try > merit:
+                    if fresh or refreshes >= 2:
+                        break
+                    lu, refreshes = None, refreshes + 1  # no descent: a fresh Jacobian
+                    continue
+                y, r, merit, fresh = trial, r_try, m_try, False
+                step = lam_ * float(np.abs(dy / xs).max())
+                if lam_ == 1.0 and step < num.newton_tol * 1e3:
                     ok = True
                     break
                 if step > 0.5 * last or (it + 1) % max_newton == 0:
