@@ -10,15 +10,20 @@ generic way:
 
 * the exact (Coulomb) law's friction ratios are unknowns; the reference takes them as
   they are, and the peer adds their equations as the usual projection (NCP) function
-  lam - proj_[-1, 1](lam + v_rel / v_aug) = 0 (:meth:`LoopProblem.local`; v_rel as the
-  reference computes it, checked against the kernel by :func:`check_slip_velocity`);
-* the Jacobian is taken by finite differences with the sparsity pattern of the stencil
-  (``scipy.optimize._numdiff.approx_derivative`` with ``sparsity=``, its columns grouped
-  once). The loop's global rows are dense (the gauge is the mean of u, each pulley's row
-  sums the friction of its arc), which would put every column in a group of its own:
-  they are taken by the chain rule instead, the gauge's row as it is written (hb / L)
-  and each pulley's as the sum of its arc's nodal frictions' rows, which the
-  differences give (the nodal frictions are outputs of the differenced function).
+  lam - proj_[-1, 1](lam + v_rel / v_aug) = 0 (:meth:`LoopProblem.residual`; v_rel as
+  the reference computes it, checked against the kernel by :func:`check_slip_velocity`),
+  solved by semi-smooth Newton: their rows of the Jacobian are the projection's
+  generalised derivative (e_lam where a node slides, -ds/dx where it sticks);
+* the Jacobian of the smooth rest is taken by finite differences with the sparsity
+  pattern of the stencil (``scipy.optimize._numdiff.approx_derivative`` with
+  ``sparsity=``, its columns grouped once), the scaled slip velocities s among the
+  differenced outputs (differences of the projection itself, across its kink, made
+  Newton crawl). The loop's global rows are dense (the gauge is the mean of u, each
+  pulley's row sums the friction of its arc), which would put every column in a group
+  of its own: they are taken by the chain rule instead, the gauge's row as it is
+  written (hb / L) and each pulley's as the sum of its arc's nodal frictions' rows,
+  which the differences give (the nodal frictions are outputs of the differenced
+  function).
 
 Peers:
 
@@ -34,7 +39,10 @@ Peers:
   reference's backward-Euler form with a shifted history) under the exact law, a
   simplified Newton iteration per step on the sparse differenced Jacobian factorised by
   ``scipy.sparse.linalg.splu`` (refreshed when it stalls), a local error estimate from a
-  quadratic predictor, and our run's steady test at our run's check times.
+  quadratic predictor, and our run's steady test at our run's check times;
+* :func:`run_ode_peer`: ``solve_ivp``'s Radau or BDF from rest on the method-of-lines
+  ODE of the tanh law (:class:`DriveODE`), dense differenced Jacobian, our run's steady
+  test on its dense output.
 
 A peer counts only if it reaches our state: each span tension and each global (the belt's
 and the pulleys' speeds) within SAME_STEADY (the steady peers, against our steady
