@@ -13,7 +13,14 @@ line of JSON (:func:`bench`'s dict):
   the cost's growth with the grid);
 * one Newton iteration's pieces on each of those grids, at the creep theory's state (the
   steady Newton's start): the residual with its Jacobian (numba), the bordered block-band
-  factorisation with its solve, and the start itself.
+  factorisation with its solve, and the start itself;
+* with ``--peers [LIST]``, generic peers on the same grid (:mod:`benchmarks.drive_peers`,
+  all on the numpy reference of the kernel's residual): Newton with a sparse
+  finite-difference Jacobian and spsolve, scipy.optimize.root krylov and hybr (against
+  our steady scheme), BDF2 steps with splu (against our start-up); with ``--peers all``
+  also solve_ivp's Radau and BDF on the tanh law's ODE form (against our start-up of the
+  tanh law, timed here). Each is stopped at ``--peer-cap`` seconds; a table of them
+  against ours is printed last before the JSON.
 
 Each wall time is the shortest of ``--repeat`` calls with the kernels loaded.
 """
@@ -90,8 +97,17 @@ def _shortest(fn, repeat):
 
 
 def difference(summary: dict, reference: dict) -> float:
-    """The largest relative difference of the KEYS (the speed ratio as the speed loss)."""
+    """The largest relative difference of the KEYS (the speed ratio as the speed loss); a
+    drive of more than two pulleys (no two-pulley KEYS): of the belt's speed, each span's
+    tension and each pulley's speed."""
     out = 0.0
+    if "tight_tension" not in reference:
+        pairs = [(summary["belt_speed"], reference["belt_speed"])]
+        pairs += [(a["tension"], b["tension"])
+                  for a, b in zip(summary["spans"], reference["spans"])]
+        pairs += [(a["speed"], b["speed"])
+                  for a, b in zip(summary["pulleys"], reference["pulleys"])]
+        return max(abs(a - b) / max(abs(b), 1e-300) for a, b in pairs)
     for k in KEYS:
         a, b = summary[k], reference[k]
         if k == "speed_ratio":
@@ -116,7 +132,10 @@ def steady(scene, repeat: int, elements=None) -> tuple[dict, object]:
         log(f"ours, steady ({elements} elements): FAILED after "
             f"{time.perf_counter() - t0:.3g} s: {exc}")
         return {"elements": elements, "failed": str(exc), "wall_time": None}, None
-    n = 2 * res.numerics.elements + 2
+    # the loop's grid may round the elements asked for (799 of 800 on the serpentine
+    # drive's 14 segments): the unknowns are its nodes' u and theta and the globals
+    st = res.solution.state
+    n = 2 * len(st.u) + len(st.g)
     its = res.newton_iterations
     out = {"elements": res.numerics.elements, "unknowns": n, "failed": None,
            "wall_time": wall, "solve_wall_time": res.wall_time, "newton_iterations": its,
@@ -206,8 +225,106 @@ def iteration_cost(scene, elements=None) -> dict:
     return out
 
 
-def bench(scene, repeat: int = 3, elements=None, grids=GRID_FACTORS, kernels=True) -> dict:
-    """Every figure of the module's docstring, as a dict."""
+#: the generic peers of ``--peers`` (benchmarks.drive_peers), by key: radau and bdf run
+#: the tanh law (a method-of-lines right-hand side needs a single-valued law)
+PEERS = ("newton", "krylov", "hybr", "bdf2", "radau", "bdf")
+#: those of ``--peers`` without a choice (``--peers all``: every one)
+DEFAULT_PEERS = PEERS[:4]
+#: the ODE peers' rtol
+ODE_RTOL = 1e-3
+
+
+def peers(scene, steady_out: dict, ours, start_out: dict, cap: float,
+          which=PEERS, repeat: int = 1) -> dict:
+    """The generic peers of :mod:`benchmarks.drive_peers` on our steady run's grid, each
+    capped at ``cap`` s, against our steady scheme (``steady_out``, its result ``ours``)
+    or our start-up (``start_out``); the ODE peers (tanh law) against our run of the tanh
+    law (its start-up, timed here, and its steady state). Prints their table."""
+    import beltsim
+    from beltsim.simulation.controller import Simulation
+    from beltsim.solvers import LoopDiscretisation
+
+    from . import drive_peers as dp
+
+    elements = steady_out["elements"]
+    base = scene.with_overrides({"numerics.elements": elements})
+    d = LoopDiscretisation(base.with_overrides({"numerics.integrator": "steady"}))
+    state = ours.solution.state
+    tanh = base.with_overrides({"numerics.friction_law": "tanh"})
+    tanh_out = tanh_state = None
+    if {"radau", "bdf"} & set(which):
+        tanh_steady = beltsim.run(tanh.with_overrides({"numerics.integrator": "steady"}))
+        tanh_state = tanh_steady.solution.state
+        # at least twice: the first run of the tanh law in a process loads its kernels
+        tanh_out = start_up(tanh, max(2, repeat), tanh_steady.solution.summary())
+    rows = []
+    for key in which:
+        log(f"peer {key} ({elements} elements, cap {cap:g} s) ...")
+        ref, against, same = state, "steady scheme", dp.SAME_STEADY
+        base_solve = steady_out["solve_wall_time"]
+        if key == "newton":
+            res = dp.run_newton_peer(d, cap=cap)
+        elif key in ("krylov", "hybr"):
+            res = dp.run_root_peer(d, key, cap=cap)
+        elif key == "bdf2":
+            res = dp.run_bdf2_peer(Simulation(base), cap=cap)
+            against, same = "start-up (default run)", dp.SAME_RUN
+            base_solve = start_out["solve_wall_time"]
+        elif key in ("radau", "bdf"):
+            res = dp.run_ode_peer(Simulation(tanh), "Radau" if key == "radau" else "BDF",
+                                  ODE_RTOL, cap=cap)
+            ref, against, same = tanh_state, "start-up, tanh law", dp.SAME_RUN
+            base_solve = tanh_out["solve_wall_time"]
+        else:
+            raise ValueError(f"unknown peer {key!r}")
+        diff = dp.difference(d, res.state, ref)
+        reached = res.converged and diff <= same
+        rows.append({"peer": key, "name": res.name, "against": against,
+                     "wall_time": res.wall_time, "converged": res.converged,
+                     "reason": res.reason, "reached": reached, "difference": diff,
+                     "tolerance": same, "ours_solve": base_solve,
+                     "ratio": res.wall_time / base_solve,
+                     "simulated_time": res.simulated_time, "statistics": res.statistics})
+        log(f"  {res.name}: {res.reason}, wall {res.wall_time:.4g} s, difference "
+            f"{diff:.2e}, its wall over our solve {res.wall_time / base_solve:.3g}"
+            f"{'' if reached else ' (did NOT reach our state)'}")
+    table(steady_out, start_out, rows, tanh_out)
+    return {"elements": elements, "cap": cap, "rows": rows, "start_up_tanh": tanh_out}
+
+
+def table(steady_out: dict, start_out: dict, rows, tanh_out=None) -> None:
+    """The peers' table, ours first (plain text)."""
+    head = ("method", "against", "call [s]", "solve [s]", "its solve over ours",
+            "reached our state", "largest difference")
+    lines = [("ours: steady scheme", "", f"{steady_out['wall_time']:.4g}",
+              f"{steady_out['solve_wall_time']:.4g}", "1", "yes", ""),
+             (f"ours: start-up ({start_out['integrator']})", "",
+              f"{start_out['wall_time']:.4g}", f"{start_out['solve_wall_time']:.4g}", "1",
+              "yes" if start_out["converged"] else "no",
+              f"{start_out['difference']:.2e}" if start_out["difference"] is not None
+              else "")]
+    if tanh_out is not None:
+        lines.append((f"ours: start-up ({tanh_out['integrator']}), tanh law", "",
+                      f"{tanh_out['wall_time']:.4g}", f"{tanh_out['solve_wall_time']:.4g}",
+                      "1", "yes" if tanh_out["converged"] else "no",
+                      f"{tanh_out['difference']:.2e}" if tanh_out["difference"] is not None
+                      else ""))
+    for r in rows:
+        ratio = f"{r['ratio']:.3g}" if r["reached"] else f">= {r['ratio']:.3g}"
+        why = "yes" if r["reached"] else (
+            f"no: {r['reason']}" if not r["converged"]
+            else f"no: {r['difference']:.1e} > {r['tolerance']:g}")
+        lines.append((r["name"], r["against"], f"{r['wall_time']:.4g}",
+                      f"{r['wall_time']:.4g}", ratio, why, f"{r['difference']:.2e}"))
+    widths = [max(len(x[i]) for x in (head, *lines)) for i in range(len(head))]
+    for line in (head, tuple("-" * w for w in widths), *lines):
+        log(" | ".join(x.ljust(w) for x, w in zip(line, widths)))
+
+
+def bench(scene, repeat: int = 3, elements=None, grids=GRID_FACTORS, kernels=True,
+          peer_cap=None, which=PEERS) -> dict:
+    """Every figure of the module's docstring, as a dict; with ``peer_cap`` (s), the
+    peers too."""
     out = {"kernels": None}
     if kernels:
         out["kernels"] = {"compile_s": kernel_time(scene, True),
@@ -224,6 +341,8 @@ def bench(scene, repeat: int = 3, elements=None, grids=GRID_FACTORS, kernels=Tru
     out["iteration"] = [iteration_cost(scene, e["elements"]) for e in out["steady"]
                         if e.get("elements")]
     out["start_up"] = start_up(scene, repeat, ref.solution.summary(), base)
+    if peer_cap is not None:
+        out["peers"] = peers(scene, first, ref, out["start_up"], peer_cap, which, repeat)
     return _plain(out)
 
 
@@ -239,6 +358,12 @@ def main(argv=None) -> int:
     p.add_argument("--grids", default=",".join(map(str, GRID_FACTORS)),
                    help="comma-separated factors of finer grids for the steady scheme")
     p.add_argument("--no-kernels", action="store_true", help="skip compile and load times")
+    p.add_argument("--peers", nargs="?", const=",".join(DEFAULT_PEERS), default=None,
+                   help="run generic peers (benchmarks.drive_peers) on the grid: "
+                        f"{', '.join(DEFAULT_PEERS)} without a value, 'all', or a "
+                        f"comma-separated choice of {', '.join(PEERS)}")
+    p.add_argument("--peer-cap", type=float, default=300.0,
+                   help="each peer's wall-time cap in s (default 300)")
     p.add_argument("--json", default=None, help="also write the dict to this file")
     args = p.parse_args(argv)
     if args.repeat < 1:
@@ -247,8 +372,16 @@ def main(argv=None) -> int:
         grids = tuple(int(g) for g in args.grids.split(",") if g)
     except ValueError:
         p.error(f"--grids: expected comma-separated whole numbers, got {args.grids!r}")
+    which = PEERS
+    if args.peers is not None:
+        which = PEERS if args.peers == "all" else tuple(k for k in args.peers.split(",")
+                                                        if k)
+        bad = [k for k in which if k not in PEERS]
+        if bad:
+            p.error(f"--peers: unknown {', '.join(bad)} (choose from {', '.join(PEERS)})")
     out = bench(load_scene(args.scene), args.repeat, args.elements, grids,
-                kernels=not args.no_kernels)
+                kernels=not args.no_kernels,
+                peer_cap=args.peer_cap if args.peers is not None else None, which=which)
     text = json.dumps(out)
     if args.json:
         with open(args.json, "w", encoding="utf-8") as fh:

@@ -48,6 +48,12 @@ STEADY_LADDER = {False: (1000, 10000, 100000), True: (1000, 4000)}
 #: the closed drive's bench (benchmarks.drive), by mode: its options
 DRIVE_ARGS = {False: [],
               True: ["--elements", "40", "--repeat", "1", "--grids", "3"]}
+#: the serpentine drive against its generic peers (benchmarks.drive --peers), by mode
+SERPENTINE_ARGS = {
+    False: ["serpentine_accessory", "--grids", "", "--no-kernels", "--peers",
+            "--peer-cap", "300"],
+    True: ["serpentine_accessory", "--elements", "60", "--repeat", "1", "--grids", "",
+           "--no-kernels", "--peers", "newton,hybr,bdf2", "--peer-cap", "30"]}
 TITLE = "Timings"
 INDEX_INTRO = (
     "How fast beltsim runs, measured by `python -m benchmarks.pages` on the machine its "
@@ -228,6 +234,7 @@ def build(page: Page, quick: bool, cold: bool = True) -> None:
                   f"s. Their spread is the machine's, not beltsim's.")
     _steady_section(page, quick, repeat)
     _drive_section(page, quick, cold)
+    _serpentine_section(page, quick)
     page.para(f"Load average at the end of the run: {os.getloadavg()[0]:.2f} (at the start: "
               f"see the top of the page); on this machine {os.cpu_count()} cores.")
 
@@ -327,6 +334,50 @@ def _drive_section(page: Page, quick: bool, cold: bool) -> None:
                 "Newton iterations", "by grid", "residual + Jacobian [ms]",
                 "bordered factorisation and solve [ms]", "the creep theory's start [ms]"],
                steady_rows)
+
+
+def _serpentine_section(page: Page, quick: bool) -> None:
+    args = SERPENTINE_ARGS[quick]
+    page.heading("The serpentine drive against generic peers")
+    page.para(
+        f"`python -m benchmarks.drive {' '.join(a or repr(a) for a in args)}`: the shipped "
+        "seven-pulley `serpentine_accessory` drive (exact Coulomb friction), our steady "
+        "scheme and our default run from rest against generic peers that solve the same "
+        "discrete equations, the numpy reference of the kernel's residual "
+        "(`physics.reference.loop_residual`), on the same grid (`benchmarks.drive_peers`): "
+        "Newton with a finite-difference Jacobian on the stencil's sparsity (columns "
+        "grouped) and spsolve, and scipy.optimize.root, from our steady scheme's start "
+        "(the creep theory's state); variable-step BDF2 from rest with the same Jacobian, "
+        "splu and our run's steady test. The exact law's ratios take the usual projection "
+        "function lam - proj(lam + v_rel / v_aug) as their equations. A peer counts only "
+        "if it reaches our state (span tensions and speeds within 1e-8 of our steady "
+        "state's, the start-up's within 1e-6); each is stopped at its cap. Ratios: the "
+        "peer's wall over our solve's.")
+    d = run_drive_bench(args)
+    pe = d["peers"]
+    st, su = d["steady"][0], d["start_up"]
+    if not su["converged"]:
+        page.fail(f"the serpentine drive's default run: {su['status']} ({su['reason']})")
+    rows = [["ours: steady scheme", "", fmt(st["wall_time"], ".4g"),
+             fmt(st["solve_wall_time"], ".4g"), "yes", "", "1"],
+            [f"ours: start-up ({su['integrator']}, {su['steps']} steps)", "",
+             fmt(su["wall_time"], ".4g"), fmt(su["solve_wall_time"], ".4g"),
+             "yes" if su["converged"] else "no", fmt(su.get("difference"), ".2e"), "1"]]
+    for r in pe["rows"]:
+        why = "yes" if r["reached"] else (
+            f"no: {r['reason']}" if not r["converged"]
+            else f"no: {fmt(r['difference'], '.1e')} > {r['tolerance']:g}")
+        rows.append([r["name"], r["against"], fmt(r["wall_time"], ".4g"), "", why,
+                     fmt(r["difference"], ".2e"),
+                     ("" if r["reached"] else ">= ") + fmt(r["ratio"], ".3g")])
+    page.table(["method", "against", "call [s]", "solve [s]", "reached our state",
+                "largest relative difference", "its wall over our solve"], rows)
+    reached = [r for r in pe["rows"] if r["reached"]]
+    for label, key in (("steady", "steady scheme"), ("start-up", "start-up (default run)")):
+        best = min((r["ratio"] for r in reached if r["against"] == key), default=None)
+        page.para(f"{pe['elements']} elements; {label}: the fastest peer that reached our "
+                  f"state took {fmt(best, '.3g') + ' times' if best else 'none reached it:'}"
+                  f" our solve's wall.")
 
 
 def main(argv=None) -> int:
