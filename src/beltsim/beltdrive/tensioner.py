@@ -102,7 +102,8 @@ def installation_tension_at(N0: float, b1: float, drawn: float, loop_length: flo
 
 def equilibrium(ten: Tensioner, layout: PulleyLayout, at, hub_of, beta0: float = 0.0,
                 step: float = 1e-3, xtol: float = 1e-14):
-    """The arm's rest angle: the root in beta of :meth:`~beltsim.beltdrive.tensioner.Tensioner.torque`.
+    """The arm's rest angle: the root in beta of
+    :meth:`~beltsim.beltdrive.tensioner.Tensioner.torque`.
 
     Parameters
     ----------
