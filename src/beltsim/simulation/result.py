@@ -52,7 +52,7 @@ class RunResult:
         Seconds: simulated, of stepping, of compiling (or loading) the kernels.
     statistics : dict
         The scheme's counters: ``steps`` and, where it has them, ``rejected_steps``,
-        ``newton_iterations``.
+        ``newton_iterations``; a tensioner's steady search adds ``arm_solves``.
     history : dict of str to numpy.ndarray
         One value per check: ``t`` (s), ``total_friction`` (N), ``rate`` and, for a
         coulomb scene, ``slip_start`` (m), ``stick_friction``, ``slip_friction`` (N)
