@@ -171,7 +171,9 @@ def ringing_span(scene: Scene, scheme: str, extra=()) -> list[tuple[str, float]]
         return []
     out = [("numerics.t_end", t_end)]
     if scheme == "explicit":
-        out.append(("numerics.max_work", DEFAULT_MAX_WORK * t_end / num.t_end))
+        # max_work is the explicit scheme's key: the scene takes it with that scheme set
+        out += [("numerics.integrator", scheme),
+                ("numerics.max_work", DEFAULT_MAX_WORK * t_end / num.t_end)]
     return out
 
 
