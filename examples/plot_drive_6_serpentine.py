@@ -1,6 +1,6 @@
 """
-A serpentine drive: seven pulleys, a tensioner, modes and the crankshaft's fluctuation
-=====================================================================================
+A serpentine drive: seven pulleys, a tensioner, modes, fluctuation
+==================================================================
 
 The shipped ``serpentine_accessory`` scene is a car's front-end accessory drive: the
 crankshaft drives the A/C compressor, the alternator, the power steering pump and the
