@@ -329,6 +329,12 @@ class SerpentineSolution:
         return None if self.alpha is None else self.alpha - self.alpha_drawn
 
     @property
+    def arm_travel(self) -> float | None:
+        """The tensioner arm's turn into the belt from its drawn angle (rad), None
+        without a tensioner."""
+        return None if self.alpha is None else self.sense_tensioner * self.alpha_offset
+
+    @property
     def stick_ends(self) -> np.ndarray:
         """Loop coordinates (m) where the slip arcs begin, one per slipping pulley in the
         belt's order (the stick zone of each arc ends there; an idler has none)."""
@@ -412,8 +418,7 @@ class SerpentineSolution:
                                 slip_margin=self.slip_margins,
                                 slip_power=self.slip_powers)}
         if self.alpha is not None:
-            out.update(arm_angle=self.alpha,
-                       arm_travel=self.sense_tensioner * self.alpha_offset)
+            out.update(arm_angle=self.alpha, arm_travel=self.arm_travel)
         return out
 
 

@@ -349,7 +349,7 @@ class Simulation:
 
         scene, P = self.scene, self.params
         try:
-            beta0 = string_state(P).summary()["arm_travel"] - P.arm_turn
+            beta0 = string_state(P).arm_travel - P.arm_turn
         except NoSolutionError:
             beta0 = 0.0
         solved = []
