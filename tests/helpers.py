@@ -74,7 +74,7 @@ def assert_errors_near(result, measured: dict, factor: float = ERROR_FACTOR):
 # (reference.residual on the straight belt, reference.loop_residual on the loop).
 
 #: The layouts of the one model: the paper's open belt and the closed two-pulley drive.
-LAYOUTS = ("straight", "loop", "serpentine")
+LAYOUTS = ("straight", "loop", "serpentine", "tensioner")
 
 #: A four-pulley drive of inner pulleys (the beam takes it): drive_flat's belt on a
 #: motor, a mill, a fan and an idler, listed counterclockwise.
@@ -122,7 +122,8 @@ LAWS = {"linear": LINEAR, "tanh": TANH, "sqrt": SQRT, "ramp": RAMP, "exact": EXA
 
 #: a backward-Euler step's 1 / dt, or 0 (the steady problem), on each layout: the loop's
 #: dt = 2e-4 s is about a thousandth of its belt's transit time
-INV_DT = {"straight": 3e3, "loop": 1.0 / 2e-4, "serpentine": 1.0 / 2e-4}
+INV_DT = {"straight": 3e3, "loop": 1.0 / 2e-4, "serpentine": 1.0 / 2e-4,
+          "tensioner": 1.0 / 2e-4}
 
 #: The loop's drive: rim speed, friction factor and load torque.
 LOOP_DRIVE = Drive(Profile.constant(12.1), Profile.constant(0.9),
@@ -201,20 +202,22 @@ def _straight_case(law, inv_dt, seed, gyro, inertia, loads, model, grid):
 
 
 def _loop_case(layout, law, inv_dt, seed, gyro, inertia, loads, model, grid):
-    """drive_flat ("loop") or its belt on SERPENTINE_BACK ("serpentine") on 60
+    """drive_flat ("loop"), its belt on SERPENTINE_BACK ("serpentine") or the shipped
+    accessory drive with its tensioner's arm (a transient's: "tensioner") on 60
     elements (about 60 nodes, 26 of them in contact on drive_flat); the regularised
     laws at half the creep speed, so that the random slip velocities reach their saturated
     part. The state's sizes are a time step's: u a strain of half N0 / b1 over an element
     (the pressure stays positive), theta N0 / b1, the speeds within 1e-3 and 1e-2 of the
     creep theory's."""
     scene = (DriveScene.load(scene_path("drive_flat")) if layout == "loop"
+             else DriveScene.load(scene_path("serpentine_tensioner")) if layout == "tensioner"
              else serpentine_scene(SERPENTINE_BACK))
     if law == "adhesion":
         data = scene.to_dict()
         data["contact"] = {"friction": "stick"}
         scene = DriveScene.from_dict(data)
     over = {"physics.model": model, "physics.inertia": inertia, "numerics.elements": 60,
-            "numerics.gyroscopic": gyro}
+            "numerics.gyroscopic": gyro, "numerics.integrator": "esdirk3"}
     if law in ("tanh", "sqrt"):
         over.update({"numerics.friction_law": law, "numerics.regularisation": 0.03})
     d = LoopDiscretisation(scene.with_overrides(over), grid)
@@ -228,9 +231,13 @@ def _loop_case(layout, law, inv_dt, seed, gyro, inertia, loads, model, grid):
     mu_, mt = 0.25 * strain * float(np.min(mesh.he)), strain
     ng = d.n_globals
     mg = np.concatenate([[rim], rim / mesh.seg_radius[d.speed_global >= 0]])
+    if d.arm is not None:  # a tensioner's arm: its angle about rest, and its rate
+        mg = np.append(mg, [0.05, 50.0])
     u, th = mu_ * rng.uniform(-1, 1, N), mt * rng.uniform(-1, 1, N)
     g = np.concatenate([[rim / (1.0 + strain) * (1.0 + 1e-3 * rng.uniform(-1, 1))],
                         mg[1:] * (1.0 + 1e-2 * rng.uniform(-1, 1, ng - 1))])
+    if d.arm is not None:
+        g[-2:] = [d.arm_rest + 0.05 * rng.uniform(-1, 1), 50.0 * rng.uniform(-1, 1)]
     lam = np.where(mesh.seg >= 0, 2.0 * rng.uniform(-1, 1, N), 0.0)
     step = INV_DT["loop"]
     old = State(u - mu_ * rng.uniform(-1, 1, N), th - mt * rng.uniform(-1, 1, N),

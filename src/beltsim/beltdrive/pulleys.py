@@ -269,6 +269,13 @@ class PulleyLayout:
         return self.radii * self.wraps
 
     @property
+    def span_angles(self) -> np.ndarray:
+        """Each span's direction angle (rad) in the counterclockwise frame (the caller's,
+        y mirrored when ``sense`` = -1): with q_i = side_i r_i, the wrap of pulley i
+        changes by side_i times the change of span i's angle less span i - 1's."""
+        return self._f.phi.copy()
+
+    @property
     def spin(self) -> np.ndarray:
         """Each pulley's turning sense in the caller's frame (+1 counterclockwise), with
         the belt running in the loop's direction: sense s_i."""

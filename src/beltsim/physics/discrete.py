@@ -83,6 +83,19 @@ class Mesh(NamedTuple):
     #: (a back-side idler's arc); a span's nodes take the next arc's, whose stencil they
     #: enter
     face: np.ndarray = np.ones(0)
+    #: a tensioner's arm (:mod:`beltsim.physics.arm`; empty without one): each
+    #: element's stretched span (0: a, arriving at the arm's pulley; 1: b, leaving it;
+    #: -1 neither), ...
+    arm_el: np.ndarray = np.zeros(0, dtype=np.int64)
+    #: ... the Chebyshev rows of the spans' length changes and their derivatives in the
+    #: arm's angle (:class:`beltsim.beltdrive.arm.ArmTable`), ...
+    arm_coef: np.ndarray = np.zeros((0, 0))
+    #: ... (k_t, tau0, damping, the reference's turn, lo, hi, l_a, l_b): the spring, the
+    #: table's interval and the stretched lengths of the two spans, ...
+    arm_par: np.ndarray = np.zeros(0)
+    #: ... and (the global of its angle (its rate the next), span a's last element,
+    #: span b's first)
+    arm_idx: np.ndarray = np.zeros(0, dtype=np.int64)
 
 
 class State(NamedTuple):

@@ -117,6 +117,29 @@ def loop_mesh(grid: LoopGrid, contacts, mu, inertia: tuple[float, ...],
                 face=face)
 
 
+def with_arm(mesh: Mesh, grid: LoopGrid, pulley: int, n_pulleys: int, glob: int, table,
+             spring: tuple[float, float, float]) -> Mesh:
+    """``mesh`` with a tensioner's arm on pulley ``pulley`` (:mod:`beltsim.physics.arm`):
+    its angle the global ``glob`` (its rate the next), ``table`` the spans' length
+    changes (:class:`beltsim.beltdrive.arm.ArmTable`), ``spring`` (k_t, tau0, damping).
+    Each of its two spans is stretched on all its elements but the last two, which the
+    next arc's friction stencils reach."""
+    first, N, he = grid.first, grid.n_elements, grid.he
+    el = -np.ones(N, dtype=np.int64)
+    lengths = []
+    for s, seg in enumerate((2 * pulley - 1, 2 * pulley + 1)):
+        seg %= 2 * n_pulleys
+        js = np.arange(first[seg], first[seg + 1] - 2)
+        el[js] = s
+        lengths.append(float(he[js].sum()))
+    span_a_end = first[(2 * pulley - 1) % (2 * n_pulleys) + 1] - 1
+    span_b_start = first[(2 * pulley + 1) % (2 * n_pulleys)]
+    return mesh._replace(
+        arm_el=el, arm_coef=np.ascontiguousarray(table.coef, dtype=float),
+        arm_par=np.array([*spring, table.turn, table.lo, table.hi, *lengths]),
+        arm_idx=np.array([glob, span_a_end, span_b_start], dtype=np.int64))
+
+
 def node_x(mesh: Mesh) -> np.ndarray:
     """The nodes' coordinates of a layout's grid (from 0)."""
     return np.concatenate([[0.0], np.cumsum(mesh.he)])[:len(mesh.hb)]

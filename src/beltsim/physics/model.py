@@ -54,6 +54,7 @@ from .discrete import (  # noqa: F401
     hermite_weights,
     load_at,
 )
+from .arm import arm_rows, arm_values, stretch
 from .friction import AUGMENTATION, EXACT, law, law_inverse
 
 # |lam| bound in the primal-dual iteration: the friction of a fully sliding node is
@@ -218,6 +219,11 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
     lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
     code, dual = p.law, p.dual
     ng = g.shape[0]
+    arm = mesh.arm_idx.shape[0] > 0
+    if arm:  # a tensioner's arm: its spans' stretch (physics.arm)
+        adelta, aslope, _ = arm_values(g[mesh.arm_idx[0]], mesh)
+    else:
+        adelta = aslope = np.zeros(2)
     for j in range(nn):
         fnode[j] = 0.0
     if closed:
@@ -251,6 +257,10 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
               + b2 * hbj * th[j])
         if closed:
             ru += rho * hbj * cd
+        if arm and (mesh.arm_el[j] >= 0 or mesh.arm_el[jm] >= 0):
+            sr, dsr = stretch(j, adelta, aslope, mesh)  # the elements right and left of j
+            sl, dsl = stretch(jm, adelta, aslope, mesh)
+            ru -= B * (sr - sl)
         if lk >= 0:
             ru -= hbj * load_at(loads.qu, loads.dqu, lk, l0, l1, m0, m1, j)
             rt -= hbj * load_at(loads.qt, loads.dqt, lk, l0, l1, m0, m1, j)
@@ -279,6 +289,9 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
                                  + 2.0 * rho * c * lap_u)
                 w.Gc[i, 1, 0] = I * (e0 * tdj + el * td_l + eu * td_r) + 2.0 * I * c * lap_t
                 w.Gr[0, i, 0] = hbj / mesh.loop_length
+                if arm and (mesh.arm_el[j] >= 0 or mesh.arm_el[jm] >= 0):
+                    w.Gc[i, 0, 0] += 2.0 * rho * c * (sr - sl)
+                    w.Gc[i, 0, mesh.arm_idx[0]] = -B * (dsr - dsl)
         if closed:
             w.Rg[0] += hbj * u[j] / mesh.loop_length
         if s >= 0:
@@ -329,6 +342,8 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
                               mesh, p, want_jac)
         R[i, 0] = ru
         R[i, 1] = rt
+    if arm:
+        arm_rows(u, g, mesh, p, w, want_jac)
 
 
 @njit(cache=True, no_cpython_wrapper=True)

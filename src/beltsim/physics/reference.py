@@ -30,6 +30,7 @@ from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.polynomial.chebyshev import chebval
 
 from ..problem.drive import friction_factor, mismatch, value, value_at
 from .discrete import CENTRAL, Mesh, ModelParams, State, hermite_weights
@@ -334,8 +335,9 @@ def loop_residual(u, th, lam, g, old, inv_dt, t, mesh: Mesh, p: ModelParams, dri
     ratio = lam if is_exact(p.law) else law_numpy(p.law, vrel / p.regularisation)[0]
     F = np.where(on, -mesh.wf * S * ratio, 0.0)
     qu, qt = loads_at(loads, t, len(u))
+    e, arm = _arm_stretch(g, mesh)
     out = np.empty((len(u), 2))
-    out[:, 0] = (rho * hb * acc_u + rho * gyro(ud) - B * lap(u)
+    out[:, 0] = (rho * hb * acc_u + rho * gyro(ud) - B * (lap(u) + e - np.roll(e, 1))
                  + rho * hb * (c - old.g[0]) * inv_dt - hb * qu - F)
     out[:, 1] = (I * hb * acc_t + I * gyro(td) - A * lap(th) + p.shear * hb * th
                  - hb * qt - hh * F)
@@ -344,4 +346,26 @@ def loop_residual(u, th, lam, g, old, inv_dt, t, mesh: Mesh, p: ModelParams, dri
     for k in range(1, len(g)):
         Rg[k] = (mesh.inertia[k] * (g[k] - old.g[k]) * inv_dt + value_at(drive.load, k, t)
                  + np.sum(R[K == k] * F[K == k]))
+    if arm is not None:
+        ib, ia, jb = mesh.arm_idx
+        kt, tau0, damp, turn = mesh.arm_par[:4]
+        slope = arm[1]
+        axial = p.N0 + p.b1 * ((np.roll(u, -1) - u) / he + e) - rho * c * c
+        Rg[ib] -= g[ib + 1]
+        Rg[ib + 1] += (damp * g[ib + 1] - tau0 + kt * (turn + g[ib]) + axial[ia] * slope[0]
+                       + axial[jb] * slope[1])
     return out, Rg, F
+
+
+def _arm_stretch(g, mesh: Mesh):
+    """A tensioner's stretch strain of each element and (delta, slope) of its two spans
+    (:mod:`beltsim.physics.arm`); zeros and None without an arm."""
+    if mesh.arm_idx.shape[0] == 0:
+        return np.zeros(len(mesh.he)), None
+    lo, hi, la, lb = mesh.arm_par[4:8]
+    x = (2.0 * g[mesh.arm_idx[0]] - lo - hi) / (hi - lo)
+    delta, slope = (np.array([chebval(x, mesh.arm_coef[r + s]) for s in (0, 1)])
+                    for r in (0, 2))
+    span = mesh.arm_el
+    e = np.where(span >= 0, delta[np.maximum(span, 0)] / np.where(span == 1, lb, la), 0.0)
+    return e, (delta, slope)

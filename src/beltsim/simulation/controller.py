@@ -80,10 +80,6 @@ class Simulation:
     def __init__(self, scene: Scene, grid: Grid | None = None,
                  snapshot_interval: float | None = None, loads=None):
         self._build(scene, grid, loads)
-        if self.disc.closed and self.params.tensioner is not None and self.scheme.transient:
-            raise SceneError("tensioner", "a tensioner's arm moves in steady solves only in "
-                             'this version (numerics.integrator = "steady"); without '
-                             "[tensioner] a transient holds the pulley where it is drawn")
         self.t = 0.0
         self.wall_time = 0.0
         num = self.numerics

@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from ..beltdrive.figures import figure_keys, layout_summary
+from ..physics.arm import element_stretches, stencil_stretch
 from ..physics.friction import EXACT, saturation
 from ..physics.model import POWER_TERMS, power_terms, traction
 from ..problem.drive import value, value_at
@@ -44,7 +45,8 @@ def history_keys(P) -> tuple[str, ...]:
     :func:`~beltsim.beltdrive.figures.figure_keys` and the powers."""
     if P.two_pulley:
         return HISTORY_KEYS
-    return ("t", "omega1", *LOOP_KEYS, *figure_keys(P.layout.names), *POWER_KEYS)
+    arm = ("arm_angle", "arm_travel") if P.tensioner is not None else ()
+    return ("t", "omega1", *LOOP_KEYS, *figure_keys(P.layout.names), *arm, *POWER_KEYS)
 
 
 class LoopSolution:
@@ -95,8 +97,9 @@ class LoopSolution:
         idx = (np.arange(N)[:, None] + np.arange(-2, 1)[None, :]) % N
         lever = prm.half_height * m.face  # the face in contact's (per node)
         # axial force: the upwind three-point strain (the friction's) at every node
-        eps = np.sum(m.sw * s.u[idx], axis=1)
-        epsb = np.sum(m.sw * (s.u[idx] + lever[:, None] * s.theta[idx]), axis=1)
+        stretch = stencil_stretch(m, s.g)  # a tensioner's spans' (physics.arm)
+        eps = np.sum(m.sw * s.u[idx], axis=1) + stretch
+        epsb = np.sum(m.sw * (s.u[idx] + lever[:, None] * s.theta[idx]), axis=1) + stretch
         tension = P.N0 + P.b1 * eps
         on = m.seg >= 0
         R = np.where(on, m.seg_radius[np.maximum(m.seg, 0)], 1.0)
@@ -132,8 +135,12 @@ class LoopSolution:
         P, u, first = self.params, self.state.u, self.disc.grid.first
         n = len(u)
         spans = P.layout.spans
-        return np.array([P.N0 + P.b1 * (u[first[2 * i + 2] % n] - u[first[2 * i + 1]])
-                         / spans[i] for i in range(len(spans))])
+        stretch = np.concatenate([[0.0], np.cumsum(element_stretches(self.mesh, self.state.g)
+                                                   * self.mesh.he)])
+        return np.array([P.N0 + P.b1 * (u[first[2 * i + 2] % n] - u[first[2 * i + 1]]
+                                        + stretch[first[2 * i + 2]]
+                                        - stretch[first[2 * i + 1]]) / spans[i]
+                         for i in range(len(spans))])
 
     def slip_arcs(self) -> tuple[float, float]:
         """The slip arc of each pulley (rad): the sliding nodes' contact lengths plus the
@@ -227,6 +234,17 @@ class LoopSolution:
             "energy": energy,
         }
 
+    def arm_figures(self) -> dict:
+        """A tensioner's ``arm_angle`` and ``arm_travel`` (rad): the layout's, turned by
+        the arm's global angle in a transient."""
+        P, m = self.params, self.mesh
+        out = P.arm_figures()
+        if m.arm_idx.shape[0]:
+            beta = float(self.state.g[m.arm_idx[0]])
+            out["arm_travel"] += beta
+            out["arm_angle"] += P.tensioner.arm(P.layout)[2] * beta
+        return out
+
     def summary(self, path: bool = False) -> dict:
         """The drive's figures: LOOP_KEYS, ``spans`` (a list in the belt's order of
         {from, to, tension}), ``pulleys`` (a list of {name, role, speed, slip_arc, wrap,
@@ -247,7 +265,7 @@ class LoopSolution:
                "slip_power": float(self._terms["slip"]),
                **layout_summary(P.layout, P.roles, P.rho, self.c, T, speeds, arcs,
                                 torques),
-               **P.arm_figures()}
+               **self.arm_figures()}
         if P.two_pulley:
             ratio = self.omega2 * P.geometry.R2 / self.rim1 if self.rim1 > 0 else math.nan
             out.update({"tight_tension": float(T[1]), "slack_tension": float(T[0]),

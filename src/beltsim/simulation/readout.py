@@ -118,6 +118,12 @@ class LoopReadout(Readout):
             self.second_scale = P.driver_rim_speed / first.radius
         #: each global's speed scale: the rim speed, and its radius for a pulley's
         radii = np.array([1.0] + [p.radius for p in P.pulleys if p.role != "driver"])
+        if disc.arm is not None:
+            # the arm's pulley moves at a beta' (over the creep speed, as u's rate) and
+            # accelerates at a beta'' (over the rim speed, as the pulleys')
+            a = P.tensioner.arm(P.layout)[0]
+            radii = np.append(radii, [a * P.b1 / P.N0, a])
+            self.periodic_keys = (*self.periodic_keys, "arm_travel")
         self._radii = radii
         self._sliding = 0
 

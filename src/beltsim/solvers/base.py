@@ -8,12 +8,14 @@ from typing import ClassVar, NamedTuple
 
 import numpy as np
 
+from ..errors import SceneError
 from ..physics.discrete import Loads, Mesh, ModelParams, State, mesh_of, model_params
 from ..physics.friction import EXACT, LINEAR, has_dual
 from ..physics.grid import Grid
-from ..physics.layout import LoopGrid, loop_mesh, loop_params
+from ..physics.layout import LoopGrid, loop_mesh, loop_params, with_arm
 from ..problem.drive import Drive, Profile, Profiles, as_profile, drive_of
 from ..problem.scene import Scene
+from .registry import get
 from .settings import Numerics, build_grid, resolve, resolve_loop
 
 
@@ -88,10 +90,15 @@ class LoopDiscretisation(Discretisation):
 
     closed = True
 
+    #: a tensioner's arm in a transient (beltsim.beltdrive.arm.ArmTable; None without)
+    arm = None
+
     def __init__(self, scene, grid: LoopGrid | None = None):
+        num = resolve_loop(scene, None if grid is None else grid.n_elements)
+        if scene.params.tensioner is not None and get(num.integrator).transient:
+            scene = _arm_reference(scene)
         self.scene = scene
         self.params = P = scene.params
-        num = resolve_loop(scene, None if grid is None else grid.n_elements)
         self.numerics: Numerics = num
         layout = P.layout
         self.grid = grid if grid is not None else LoopGrid.build(layout.lengths,
@@ -131,6 +138,66 @@ class LoopDiscretisation(Discretisation):
         self.scales: Scales = Scales(P.N0, P.N0 * max(P.h, 1e-300), L * strain, strain,
                                      np.concatenate([[rim], rim / radii]),
                                      np.concatenate([[L * strain], P.N0 * radii]))
+        if P.tensioner is not None and get(num.integrator).transient:
+            self._add_arm()
+
+    def _add_arm(self):
+        """The tensioner's arm as two more globals, its angle from the grid's layout and
+        its rate (:mod:`beltsim.physics.arm`), and the state at rest with the arm
+        settled."""
+        from ..beltdrive.arm import TRAVEL, arm_table, rest_angle
+
+        P, ten = self.params, self.params.tensioner
+        if not ten.inertia > 0:
+            raise SceneError("tensioner.inertia", "must be > 0 in a transient (the arm's "
+                             "moment of inertia about its pivot, kg m^2, its pulley's mass "
+                             "included)")
+        if self.numerics.integrator == "explicit":
+            raise SceneError("tensioner", 'a tensioner\'s arm moves in the implicit schemes '
+                             '("esdirk3", "implicit", "pseudo") and the steady solve; '
+                             '"explicit" does not step it yet')
+        table = arm_table(P)
+        rest, _ = rest_angle(P, table)
+        if abs(rest) > 0.5 * TRAVEL:  # the table reaches round the rest angle too
+            table = arm_table(P, rest)
+            rest, _ = rest_angle(P, table)
+        self.arm, self.arm_rest = table, rest
+        ng = self.n_globals
+        self.n_globals = ng + 2
+        self.mesh = with_arm(self.mesh._replace(inertia=np.append(self.mesh.inertia,
+                                                                  [1.0, ten.inertia])),
+                             self.grid, ten.index, len(P.pulleys), ng, table,
+                             (ten.stiffness, ten.preload, ten.damping))
+        d = self.drive
+        self.drive = d._replace(load=Profiles.of(
+            [d.load.profile(k) for k in range(ng)] + [Profile.constant(0.0)] * 2))
+        # the arm's scales: the turn that takes up the belt's stretch (its length times
+        # the installation strain over the arm's length), that turn at the driver's speed,
+        # and the spring's torque over it
+        arm_length = ten.arm(P.layout)[0]
+        turn = P.layout.loop_length * P.N0 / P.b1 / arm_length
+        rate = turn * P.omega1
+        sc = self.scales
+        self.scales = sc._replace(glob=np.append(sc.glob, [turn, rate]),
+                                  gres=np.append(sc.gres, [rate, P.N0 * arm_length]))
+
+    def new_state(self) -> State:
+        """The belt at rest: with a tensioner's arm, the arm settled at its rest angle and
+        the belt's tension uniform (its spans' stretch taken up by u)."""
+        state = super().new_state()
+        if self.arm is None:
+            return state
+        from ..physics.arm import arm_values, stretch
+
+        P, m = self.params, self.mesh
+        state.g[m.arm_idx[0]] = self.arm_rest
+        delta, slope, _ = arm_values(self.arm_rest, m)
+        e = np.array([stretch(j, delta, slope, m)[0] for j in range(len(m.he))])
+        # uniform strain N_s / b1: u_x = (N_s - N0) / b1 - e, periodic with zero mean
+        ux = np.sum(e * m.he) / P.layout.loop_length - e
+        u = np.concatenate([[0.0], np.cumsum(ux * m.he)[:-1]])
+        state.u[:] = u - np.sum(m.hb * u) / P.layout.loop_length
+        return state
 
     @property
     def window(self) -> float:
@@ -146,6 +213,24 @@ class LoopDiscretisation(Discretisation):
     def with_grid(self, grid: LoopGrid) -> LoopDiscretisation:
         """The same drive on another grid."""
         return LoopDiscretisation(self.scene, grid)
+
+
+def _arm_reference(scene):
+    """A drive scene with a tensioner, its arm turned to where the grid of a transient is
+    laid: the exact steady state's rest angle (the creep theory's where the model has
+    none), so that the run's own rest angle, near it, is read on that geometry; the
+    drawn angle where the drive has no steady state (a run into gross slip)."""
+    from ..beltdrive.exact import exact_state, string_state
+    from ..errors import NoSolutionError
+
+    P = scene.params
+    for solve in (exact_state, string_state):
+        try:
+            travel = solve(P).arm_travel
+        except NoSolutionError:
+            continue
+        return scene.at_arm(travel - P.arm_turn)
+    return scene
 
 
 def discretise(scene, grid=None) -> Discretisation:
