@@ -21,7 +21,12 @@ i.e. K_ii = q_i^2 (k_{i-1} + k_i), K_{i,i+1} = K_{i+1,i} = -q_i q_{i+1} k_i. The
 rotation is prescribed (held, in a perturbation): its row and column go, leaving N - 1
 rotational degrees of freedom with the mass matrix M = diag(J_i). The natural
 frequencies solve K x = omega^2 M x (a symmetric definite pencil, scipy.linalg.eigh).
-No tensioner arm: its degree of freedom and geometric stiffness are not in the model.
+
+A tensioner's arm (Beikmann, Perkins and Ulsoy 1996) adds its angle beta, with the arm's
+inertia J_a: turning it lengthens its two spans a and b by delta_a'(0) beta and
+delta_b'(0) beta (:mod:`beltsim.beltdrive.arm`), so a_a and a_b gain those entries in
+beta's column, and the arm's own stiffness is its spring's and the spans' geometric one,
+k_t + T_a delta_a'' + T_b delta_b'' (T the spans' tensions less rho c^2).
 """
 
 from __future__ import annotations
@@ -33,7 +38,7 @@ import numpy as np
 import scipy.linalg
 
 
-def stiffness_matrix(signed_radii, span_stiffness) -> np.ndarray:
+def stiffness_matrix(signed_radii, span_stiffness, arm=None) -> np.ndarray:
     """The N x N stiffness matrix of N pulleys on a loop of springs (all pulleys free).
 
     Parameters
@@ -42,6 +47,9 @@ def stiffness_matrix(signed_radii, span_stiffness) -> np.ndarray:
         q_i = s_i r_i (m): negative for a back-side idler.
     span_stiffness : array_like
         k_j = b1 / l_j (N/m) of span j, from pulley j to pulley j + 1 (mod N).
+    arm : array_like, optional
+        Each span's stretch per unit turn of a tensioner's arm (m/rad): the arm's angle
+        is then an (N + 1)-th degree of freedom (its spring not included).
 
     Returns
     -------
@@ -53,12 +61,15 @@ def stiffness_matrix(signed_radii, span_stiffness) -> np.ndarray:
     n = len(q)
     if len(k) != n or n < 2:
         raise ValueError(f"need N >= 2 radii and as many spans, got {n} and {len(k)}")
-    K = np.zeros((n, n))
+    m = n if arm is None else n + 1
+    K = np.zeros((m, m))
     for j in range(n):
-        a = np.zeros(n)
+        a = np.zeros(m)
         # two pulleys: spans 0 and 1 both join pulley 0 to pulley 1
         a[(j + 1) % n] += q[(j + 1) % n]
         a[j] -= q[j]
+        if arm is not None:
+            a[n] = arm[j]
         K += k[j] * np.outer(a, a)
     return K
 
@@ -101,29 +112,52 @@ class RotationalModel:
         return self.solve()[0] / (2.0 * math.pi)
 
 
-def rotational_model(params) -> RotationalModel:
+def rotational_model(params, tension: float | None = None) -> RotationalModel:
     """The discrete rotational model of a drive's data.
 
     Parameters
     ----------
     params : DriveParams
         The drive (a drive scene's ``params``):
-        its layout's spans and sides, its pulleys' radii and inertias, b1 = EA.
+        its layout's spans and sides, its pulleys' radii and inertias, b1 = EA; with a
+        tensioner, its layout the one with the arm at rest.
+    tension : float, optional
+        With a tensioner: the spans' tension less rho c^2 (N), equal in every span
+        without loads (default: the installation tension N0 of ``params``).
 
     Returns
     -------
     RotationalModel
-        With the driver's rotation held.
+        With the driver's rotation held; a tensioner's arm angle the last degree of
+        freedom (named "arm").
     """
     layout = params.layout
     q = layout.sides * layout.radii
     k = params.b1 / layout.spans
     K = stiffness_matrix(q, k)
     keep = [i for i in range(len(q)) if i != params.driver]
-    return RotationalModel(
-        names=tuple(layout.names[i] for i in keep),
-        inertia=np.array([params.pulleys[i].inertia for i in keep]),
-        stiffness=K[np.ix_(keep, keep)], signed_radii=q[keep], span_stiffness=k)
+    names = tuple(layout.names[i] for i in keep)
+    inertia = np.array([params.pulleys[i].inertia for i in keep])
+    ten = params.tensioner
+    if ten is not None:
+        from .arm import arm_table
+
+        n = len(q)
+        table = arm_table(params)
+        T = params.N0 if tension is None else tension
+        # each span's stretch per unit of the arm's angle: spans a (into the arm's
+        # pulley) and b (out of it)
+        g = np.zeros(n)
+        g[(ten.index - 1) % n] += table(0.0, 2)
+        g[ten.index] += table(0.0, 3)
+        K = stiffness_matrix(q, k, g)
+        K[n, n] += ten.stiffness + T * (table(0.0, 4) + table(0.0, 5))
+        keep = [*keep, n]
+        names = (*names, "arm")
+        inertia = np.append(inertia, ten.inertia)
+        q = np.append(q, 0.0)
+    return RotationalModel(names=names, inertia=inertia, stiffness=K[np.ix_(keep, keep)],
+                           signed_radii=q[keep], span_stiffness=k)
 
 
 #: The limit's belt: the scene's density times this. Far smaller loses digits: the belt
@@ -137,7 +171,8 @@ def adhesion_limit(scene, light: float = LIGHT, speed: float = 0.5, elements: in
     """A drive scene in the rotational model's limit.
 
     Perfect adhesion (``contact.friction = "stick"``), no load torques (both tensions of
-    every pulley equal: no creep), the belt ``light`` times as dense, no damping, the
+    every pulley equal: no creep), the belt ``light`` times as dense, no damping (a
+    tensioner's arm's neither), the
     string, the driver at ``speed`` rad/s: so slow that the transport of the strain
     frozen on the stuck arcs shows as overdamped pairs of a few hertz, apart from the
     rotational modes.
@@ -169,6 +204,8 @@ def adhesion_limit(scene, light: float = LIGHT, speed: float = 0.5, elements: in
         data["drive"].update(driver_speed=speed, load_torque=0.0)
     data["belt"]["density"] *= light
     data["physics"].update(damping=0.0, model="string")
+    if "tensioner" in data:  # its arm undamped too
+        data["tensioner"]["damping"] = 0.0
     data.setdefault("numerics", {})["elements"] = elements
     return type(scene).from_dict(data)
 

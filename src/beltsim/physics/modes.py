@@ -127,7 +127,15 @@ def steady_discretisation(scene, elements=None):
         over.append(f"numerics.elements={elements}")
     sim = Simulation(steady_scene(scene).with_overrides(over))
     sim.run(raise_on_failure=True)
-    return sim.disc, sim.state
+    disc, state = sim.disc, sim.state
+    if getattr(disc.params, "tensioner", None) is not None:
+        # the arm's angle and rate join the globals, from its rest on the solved layout
+        from ..solvers.base import LoopDiscretisation
+
+        disc = LoopDiscretisation(disc.scene, disc.grid, arm=True)
+        state = state._replace(g=np.append(state.g, [0.0, 0.0]),
+                               gd=np.append(state.gd, [0.0, 0.0]))
+    return disc, state
 
 
 def steady_scene(scene):

@@ -81,11 +81,14 @@ class Discretisation:
 
 class LoopDiscretisation(Discretisation):
     """A closed drive on its periodic grid: the loop layout (each pulley's arc and the
-    span to the next, in the belt's order), its global unknowns (the belt speed c and
-    the speed of every pulley but the driver, in the pulleys' order) and the named
-    structures the kernels read.
+    span to the next, in the belt's order), its global unknowns (the belt speed c, the
+    speed of every pulley but the driver, in the pulleys' order, and a moving tensioner
+    arm's angle and rate) and the named structures the kernels read.
 
     ``grid`` replaces the default grid (a :class:`~beltsim.physics.layout.LoopGrid`).
+    ``arm``: whether a tensioner's arm moves (its two globals, from the layout as given);
+    by default it does in a transient, from the exact steady state's rest angle, and a
+    steady solve holds it (its search turns the layout instead).
     """
 
     closed = True
@@ -93,10 +96,12 @@ class LoopDiscretisation(Discretisation):
     #: a tensioner's arm in a transient (beltsim.beltdrive.arm.ArmTable; None without)
     arm = None
 
-    def __init__(self, scene, grid: LoopGrid | None = None):
+    def __init__(self, scene, grid: LoopGrid | None = None, arm: bool | None = None):
         num = resolve_loop(scene, None if grid is None else grid.n_elements)
-        if scene.params.tensioner is not None and get(num.integrator).transient:
-            scene = _arm_reference(scene)
+        if arm is None:  # a transient moves a tensioner's arm from the exact rest angle
+            arm = scene.params.tensioner is not None and get(num.integrator).transient
+            if arm:
+                scene = _arm_reference(scene)
         self.scene = scene
         self.params = P = scene.params
         self.numerics: Numerics = num
@@ -138,7 +143,7 @@ class LoopDiscretisation(Discretisation):
         self.scales: Scales = Scales(P.N0, P.N0 * max(P.h, 1e-300), L * strain, strain,
                                      np.concatenate([[rim], rim / radii]),
                                      np.concatenate([[L * strain], P.N0 * radii]))
-        if P.tensioner is not None and get(num.integrator).transient:
+        if arm and P.tensioner is not None:
             self._add_arm()
 
     def _add_arm(self):
@@ -212,7 +217,7 @@ class LoopDiscretisation(Discretisation):
 
     def with_grid(self, grid: LoopGrid) -> LoopDiscretisation:
         """The same drive on another grid."""
-        return LoopDiscretisation(self.scene, grid)
+        return LoopDiscretisation(self.scene, grid, arm=self.arm is not None)
 
 
 def _arm_reference(scene):
