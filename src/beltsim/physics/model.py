@@ -41,6 +41,7 @@ import numpy as np
 from numba import njit
 
 from ..problem.drive import friction_factor, mismatch, value, value_at
+from .arm import arm_rows, arm_values, stretch
 
 # Loads and State are not used here: numba's cache indexes written before they moved to
 # physics.discrete name them here, and unpickling such an index must find them, or every
@@ -54,7 +55,6 @@ from .discrete import (  # noqa: F401
     hermite_weights,
     load_at,
 )
-from .arm import arm_rows, arm_values, stretch
 from .friction import AUGMENTATION, EXACT, law, law_inverse
 
 # |lam| bound in the primal-dual iteration: the friction of a fully sliding node is

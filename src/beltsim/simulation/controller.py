@@ -17,7 +17,7 @@ import time
 import numpy as np
 
 from .. import solvers
-from ..errors import NumericalError, SceneError
+from ..errors import NumericalError
 from ..physics.grid import Grid
 from ..problem.drive import period_of, profile_times
 from ..problem.scene import Scene
