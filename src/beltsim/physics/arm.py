@@ -99,15 +99,16 @@ def arm_rows(u, g, mesh, p, w, want_jac):
     w.Gr[iw, jb, 0] -= kb
 
 
-def element_stretches(mesh, g) -> np.ndarray:
-    """Each element's stretch strain e (N) at the globals ``g`` (zeros without an arm)."""
+def element_stretches(mesh, g, slope: bool = False) -> np.ndarray:
+    """Each element's stretch strain e (N) at the globals ``g``, or with ``slope`` its
+    derivative in the arm's angle (zeros without an arm)."""
     e = np.zeros(len(mesh.he))
     if mesh.arm_idx.shape[0] == 0:
         return e
-    delta, _, _ = arm_values(float(g[mesh.arm_idx[0]]), mesh)
+    values = arm_values(float(g[mesh.arm_idx[0]]), mesh)[1 if slope else 0]
     ln = mesh.arm_par[[LENGTH_A, LENGTH_B]]
     on = mesh.arm_el >= 0
-    e[on] = delta[mesh.arm_el[on]] / ln[mesh.arm_el[on]]
+    e[on] = values[mesh.arm_el[on]] / ln[mesh.arm_el[on]]
     return e
 
 

@@ -27,11 +27,12 @@ measure).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import SceneError, UsageError
+from .arm import element_stretches
 from .modes import eigenpairs, steady_discretisation
 
 #: The grid when the scene sets none: the dense QZ algorithm's cost grows as the cube of
@@ -257,10 +258,13 @@ class ForcedResponse:
     frequencies: np.ndarray
     tension: dict
     speed: dict
+    #: a tensioner's arm angle (rad per rad/s), by ``arm_travel``; empty without one
+    arm: dict = field(default_factory=dict)
 
     def amplitudes(self, amplitude: float = 1.0) -> dict:
         """Every figure's amplitude for a driver's speed amplitude (rad/s), by key."""
-        return {k: amplitude * np.abs(v) for k, v in (self.tension | self.speed).items()}
+        return {k: amplitude * np.abs(v)
+                for k, v in (self.tension | self.speed | self.arm).items()}
 
 
 def forced_response(scene, frequencies, elements: int | None = None) -> ForcedResponse:
@@ -314,14 +318,21 @@ def forced_response(scene, frequencies, elements: int | None = None) -> ForcedRe
     speed = {f"speed[{p.name}]": np.zeros(f_hz.size, complex)
              for p, k in zip(P.pulleys, disc.speed_global) if k >= 0}
     he = grid.he
+    # a tensioner's arm: its spans' stretch per unit angle (physics.arm), and its angle
+    arm_at = disc.mesh.arm_idx[0] if disc.mesh.arm_idx.shape[0] else None
+    de = element_stretches(disc.mesh, state.g, slope=True)
+    arm = {} if arm_at is None else {"arm_travel": np.zeros(f_hz.size, complex)}
     for m, f in enumerate(f_hz):
         w = 2.0 * math.pi * f
         z = spla.spsolve((-w * w * M + 1j * w * C + K).tocsc(), rhs.astype(complex))
         u = z[0:b * n:b]
+        beta = 0.0 if arm_at is None else z[b * n + arm_at]
         for i in range(len(names)):
             j = e[i]
-            tension[keys[i]][m] = P.b1 * (u[(j + 1) % n] - u[j]) / he[j]
+            tension[keys[i]][m] = P.b1 * ((u[(j + 1) % n] - u[j]) / he[j] + de[j] * beta)
         for p, k in zip(P.pulleys, disc.speed_global):
             if k >= 0:
                 speed[f"speed[{p.name}]"][m] = z[b * n + k]
-    return ForcedResponse(f_hz, tension, speed)
+        if arm:
+            arm["arm_travel"][m] = beta
+    return ForcedResponse(f_hz, tension, speed, arm)
