@@ -1,6 +1,7 @@
 """Steady state of the closed drive: the shear-deformable beam, solved exactly.
 
-The loop x in [0, Lambda) runs driver arc, slack span, driven arc, tight span. At steady
+Two pulleys first: the loop x in [0, Lambda) runs driver arc, slack span, driven arc,
+tight span. At steady
 state, with B = b1 - rho c^2, A = a - I c^2 and the friction's lever l (h/2 for the beam,
 0 for the string)::
 
@@ -37,6 +38,21 @@ the length and the balance) are the residuals of a damped Newton iteration on (c
 Perfect adhesion (mu None) sticks on the whole arc, with a concentrated force F_i at each
 exit where [[B eps]] = -F_i and [[A theta']] = -l F_i; then only c is iterated. omega_2
 follows from e_2.
+
+N pulleys. The same pieces close the loop on any layout
+(:class:`~beltsim.beltdrive.pulleys.PulleyLayout`, x from pulley 0's entry): every arc
+sticks, then slips at its exit (s_i = +1 on the driver, -1 on a loaded pulley). An idler's stick zone carries the
+friction B l theta'' of theta's boundary layers, whose resultant has either sign; its
+slip arc balances it, so its slip variable is signed and passes through 0 (a slip piece
+of length 0 is the same state whatever its sign). A back-side pulley's friction acts on
+the belt's outer face: the lever is -l on its arc, in the moment, the fibre's speed, the
+stick zone's friction, g and an adhesive exit's jump (alpha sees l^2). Newton iterates c
+and the N slip arcs on the closure, the length and every non-driver pulley's balance
+(R_i times the integral of f over its arc = -M_i, 0 for an idler), from the creep
+theory's state (:mod:`beltsim.beltdrive.creep`, exact at l = 0) with the continuation in
+l behind it. The frictions sum to zero round the loop (B eps is periodic), so the
+driver's torque is r_d sum_i M_i / r_i as on the string; the power argument below holds
+arc by arc.
 
 Starts. Newton starts from the string's closed-form state (exact at l = 0, so a
 continuation in l backs it up); near the capacity from the beam's capacity state; failing
