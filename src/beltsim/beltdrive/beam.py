@@ -41,8 +41,9 @@ follows from e_2.
 
 N pulleys. The same pieces close the loop on any layout
 (:class:`~beltsim.beltdrive.pulleys.PulleyLayout`, x from pulley 0's entry): every arc
-sticks, then slips at its exit (s_i = +1 on the driver, -1 on a loaded pulley). An idler's stick zone carries the
-friction B l theta'' of theta's boundary layers, whose resultant has either sign; its
+sticks, then slips at its exit (s_i = +1 on the driver, -1 on a loaded pulley). An
+idler's stick zone carries the friction B l theta'' of theta's boundary layers, whose
+resultant has either sign; its
 slip arc balances it, so its slip variable is signed and passes through 0 (a slip piece
 of length 0 is the same state whatever its sign). A back-side pulley's friction acts on
 the belt's outer face: the lever is -l on its arc, in the moment, the fibre's speed, the
