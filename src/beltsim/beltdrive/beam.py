@@ -1,6 +1,7 @@
 """Steady state of the closed drive: the shear-deformable beam, solved exactly.
 
-The loop x in [0, Lambda) runs driver arc, slack span, driven arc, tight span. At steady
+Two pulleys first: the loop x in [0, Lambda) runs driver arc, slack span, driven arc,
+tight span. At steady
 state, with B = b1 - rho c^2, A = a - I c^2 and the friction's lever l (h/2 for the beam,
 0 for the string)::
 
@@ -38,6 +39,22 @@ Perfect adhesion (mu None) sticks on the whole arc, with a concentrated force F_
 exit where [[B eps]] = -F_i and [[A theta']] = -l F_i; then only c is iterated. omega_2
 follows from e_2.
 
+N pulleys. The same pieces close the loop on any layout
+(:class:`~beltsim.beltdrive.pulleys.PulleyLayout`, x from pulley 0's entry): every arc
+sticks, then slips at its exit (s_i = +1 on the driver, -1 on a loaded pulley). An
+idler's stick zone carries the friction B l theta'' of theta's boundary layers, whose
+resultant has either sign; its
+slip arc balances it, so its slip variable is signed and passes through 0 (a slip piece
+of length 0 is the same state whatever its sign). A back-side pulley's friction acts on
+the belt's outer face: the lever is -l on its arc, in the moment, the fibre's speed, the
+stick zone's friction, g and an adhesive exit's jump (alpha sees l^2). Newton iterates c
+and the N slip arcs on the closure, the length and every non-driver pulley's balance
+(R_i times the integral of f over its arc = -M_i, 0 for an idler), from the creep
+theory's state (:mod:`beltsim.beltdrive.creep`, exact at l = 0) with the continuation in
+l behind it. The frictions sum to zero round the loop (B eps is periodic), so the
+driver's torque is r_d sum_i M_i / r_i as on the string; the power argument below holds
+arc by arc.
+
 Starts. Newton starts from the string's closed-form state (exact at l = 0, so a
 continuation in l backs it up); near the capacity from the beam's capacity state; failing
 both, from a continuation in the load from the unloaded drive (uniform strain, no slip),
@@ -68,6 +85,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -80,6 +98,7 @@ from .beam_loop import (
     MAX_ITERATIONS,
     STEP_TOL,
     _converge,
+    _frame,
     _graded,
     _Loop,
     _newton,
@@ -87,6 +106,7 @@ from .beam_loop import (
     _unpack,
 )
 from .beam_solution import BeamSolution, _loop_quadrature
+from .creep import serpentine_data, solve_serpentine
 from .params import DriveParams
 
 #: A load continuation that stalls with the slack side's N - rho c^2 below this fraction of
@@ -112,7 +132,8 @@ def _defaults(P, omega1, M2):
 def _check_bending(P: DriveParams, omega1: float):
     """Refuse a drive whose belt, near the rim speed, has A = a - I c^2 <= 0: there theta's
     equation loses its decaying solutions and the beam has no steady state."""
-    c = omega1 * P.geometry.R1 / (1.0 + P.N0 / P.b1)  # the unloaded belt speed
+    # the unloaded belt speed
+    c = omega1 * P.layout.radii[P.driver] / (1.0 + P.N0 / P.b1)
     if P.lever > 0 and not P.a - P.I * c * c > 0:
         raise NoSolutionError(
             f"drive.driver_speed: at the belt speed {c:.6g} m/s the rotary inertia I c^2 = "
@@ -122,7 +143,7 @@ def _check_bending(P: DriveParams, omega1: float):
 
 def _fits(P: DriveParams, d) -> bool:
     """Whether both slip arcs of lengths d (m) lie within their wraps."""
-    return all(d[k] <= P.geometry.arcs[k] for k in (0, 1))
+    return bool(np.all(np.abs(d) <= np.asarray(_frame(P).arcs)))
 
 
 def _string_start(P: DriveParams, omega1: float, M2: float):
@@ -170,8 +191,8 @@ def _march(P: DriveParams, omega1: float, target: float):
     while M < target:
         trial = min(M + dM, target)
         try:
-            loop, z, y_new = _newton(P, P.lever, omega1, trial, "load", y)
-            ok = _fits(P, _unpack(P, "load", y_new)[1]) or "over"
+            loop, z, y_new = _newton(P, P.lever, omega1, (0.0, trial), "load", y)
+            ok = _fits(P, _unpack(P, "load", y_new, (0.0, trial))[1]) or "over"
             if ok is True and not _lowest_pressure(loop, z) > 0:
                 ok = "lift"
         except _NotConverged:
@@ -195,21 +216,21 @@ def _capacity_near(P: DriveParams, omega1: float, M: float, y):
     """(capacity, loop, z) by Newton with a slip arc pinned to its whole wrap and the load
     unknown, started from an admissible state (load M, unknowns y) close below it."""
     g = P.geometry
-    c, d, _ = _unpack(P, "load", y)
+    c, d, _ = _unpack(P, "load", y, (0.0, M))
     w = (y[1], y[2])
-    first = 0 if d[0] / g.arcs[0] >= d[1] / g.arcs[1] else 1
+    first = 0 if abs(d[0]) / g.arcs[0] >= abs(d[1]) / g.arcs[1] else 1
     failures = []
     for arc in (first, 1 - first):
         mode = ("cap1", "cap2")[arc]
         y0 = [c, w[0], w[1]]
         y0[1 + arc] = M / (g.R2 * P.N0)
         try:
-            loop, z, y_cap = _newton(P, P.lever, omega1, 0.0, mode, y0)
+            loop, z, y_cap = _newton(P, P.lever, omega1, (0.0, 0.0), mode, y0)
         except (_NotConverged, NoSolutionError) as exc:
             failures.append(str(exc))
             continue
-        _, d_cap, cap = _unpack(P, mode, y_cap)
-        if d_cap[1 - arc] <= g.arcs[1 - arc] * (1.0 + 1e-12):
+        _, d_cap, (_, cap) = _unpack(P, mode, y_cap, (0.0, 0.0))
+        if abs(d_cap[1 - arc]) <= g.arcs[1 - arc] * (1.0 + 1e-12):
             return cap, loop, z
     raise NoSolutionError(f"beam drive: no capacity found at {omega1:g} rad/s "
                           f"({'; '.join(failures) or 'no slip arc fits its wrap'})")
@@ -269,8 +290,8 @@ def _solve_coulomb(P: DriveParams, omega1: float, M2: float):
     start = _string_start(P, omega1, M2)
     if start is not None:
         try:
-            loop, z, y = _converge(P, omega1, M2, "load", start)
-            if _fits(P, _unpack(P, "load", y)[1]):
+            loop, z, y = _converge(P, omega1, (0.0, M2), "load", start)
+            if _fits(P, _unpack(P, "load", y, (0.0, M2))[1]):
                 return loop, z
         except _NotConverged:
             pass
@@ -283,10 +304,10 @@ def _solve_coulomb(P: DriveParams, omega1: float, M2: float):
             raise _gross_slip(P, omega1, M2, cap)
         d = [seg.length for seg in loop.segs if seg.kind == "slip"]
         try:
-            loop, z, y = _newton(P, P.lever, omega1, M2, "load",
+            loop, z, y = _newton(P, P.lever, omega1, (0.0, M2), "load",
                                  (loop.c, d[0] * P.mu / P.geometry.R1,
                                   d[1] * P.mu / P.geometry.R2))
-            if _fits(P, _unpack(P, "load", y)[1]):
+            if _fits(P, _unpack(P, "load", y, (0.0, M2))[1]):
                 return loop, z
         except _NotConverged:
             pass
@@ -316,9 +337,37 @@ def _margin(found) -> float:
     """(T2 - rho c^2) / (T1 - rho c^2) of a state (loop, z): the slack side's share."""
     loop, z = found
     zz = np.append(z, 1.0)
-    n = [float(loop.pressure(i, 0.0)[0] @ zz) * loop.P.geometry.radii[seg.arc]
+    n = [float(loop.pressure(i, 0.0)[0] @ zz) * loop.radii[seg.arc]
          for i, seg in enumerate(loop.segs) if seg.kind == "stick"]
     return n[1] / n[0]
+
+
+def _solve_layout(P: DriveParams, omega1: float):
+    """(loop, z, loads) of a drive on N pulleys, by Newton (backed by the continuation in
+    the lever) from the creep theory's state, which is exact at l = 0: its belt speed
+    and slip arcs, the idlers' slip arcs 0.
+
+    The creep theory's gross slip and lift-off are this drive's too (the capacities
+    differ by O(l), not searched for here); a beam slip arc beyond its wrap is gross
+    slip."""
+    data = replace(serpentine_data(replace(P, tensioner=None)), omega=omega1)
+    loads = np.array(data.loads)
+    s = solve_serpentine(data)
+    mus = np.ones(len(loads)) if P.mu is None else np.asarray(P.mus)
+    mode, y0 = ("stick", (s.c,)) if P.mu is None else ("load", (s.c, *(mus * s.phi_s)))
+    try:
+        loop, z, y = _converge(P, omega1, loads, mode, y0)
+    except _NotConverged as exc:
+        raise NoSolutionError(f"beam drive: no steady state found from the creep "
+                              f"theory's ({exc})") from None
+    d = _unpack(P, mode, y, loads)[1]
+    if d is not None and not _fits(P, d):
+        i = int(np.argmax(np.abs(d) / P.layout.arcs))
+        raise GrossSlipError(f"pulley {P.layout.names[i]!r}: the beam's slip arc "
+                             f"{abs(d[i]) / P.layout.radii[i]:.4g} rad exceeds its wrap "
+                             f"{P.layout.wraps[i]:.4g} rad (gross slip: no steady state)",
+                             math.nan)
+    return loop, z, loads
 
 
 def solve_beam(P: DriveParams, omega1: float | None = None,
@@ -326,19 +375,30 @@ def solve_beam(P: DriveParams, omega1: float | None = None,
     """The shear-deformable beam's steady state at driver speed omega1 and load M2 (the
     scene's final values by default); ``P.lever`` = 0 (the string model) gives the string.
 
-    Newton starts from the string's closed-form state; where that fails, from a
-    continuation in the load.
+    On two pulleys Newton starts from the string's closed-form state; where that fails,
+    from a continuation in the load. On N pulleys (M2 then must be None: the loads are
+    the pulleys' own) it starts from the creep theory's state (:func:`_solve_layout`).
 
     Raises
     ------
     GrossSlipError
         The load exceeds the beam drive's capacity
-        (:func:`beltsim.beltdrive.beam.capacity`, in the message).
+        (:func:`beltsim.beltdrive.beam.capacity`, in the message; NaN on N pulleys).
     LiftOffError
         The contact pressure does not stay positive on the arcs.
     NoSolutionError
         No steady state of the assumed layout (the message names what fails).
     """
+    if not P.two_pulley:
+        if M2 is not None:
+            raise ValueError("M2: only for the two-pulley drive (the pulleys carry their "
+                             "own loads)")
+        omega1, _ = _defaults(P, omega1, 0.0)
+        _check_bending(P, omega1)
+        loop, z, loads = _solve_layout(P, omega1)
+        sol = BeamSolution(P, omega1, loads, loop, z)
+        sol._check()
+        return sol
     omega1, M2 = _defaults(P, omega1, M2)
     g = P.geometry
     _check_bending(P, omega1)
@@ -348,12 +408,12 @@ def solve_beam(P: DriveParams, omega1: float | None = None,
         except ValueError:  # the string lifts off: start from the unloaded belt speed
             c0 = omega1 * g.R1 / (1.0 + P.N0 / P.b1)
         try:
-            loop, z, _ = _converge(P, omega1, M2, "stick", (c0,))
+            loop, z, _ = _converge(P, omega1, (0.0, M2), "stick", (c0,))
         except _NotConverged as exc:
             raise NoSolutionError(f"beam drive: no steady state found ({exc})") from None
     else:
         loop, z = _solve_coulomb(P, omega1, M2)
-    sol = BeamSolution(P, omega1, M2, loop, z)
+    sol = BeamSolution(P, omega1, (0.0, M2), loop, z)
     sol._check()
     return sol
 

@@ -28,6 +28,13 @@ MAX_DAMPED = 4
 _GAUSS = np.polynomial.legendre.leggauss(16)
 
 
+def _frame(P: DriveParams):
+    """The loop's bounds, radii and arcs: the two-pulley drive's closed-form
+    :class:`~beltsim.beltdrive.geometry.Geometry`, which its other solutions and figures
+    share (the layout's agrees with it to round-off), else the layout's."""
+    return P.geometry if P.two_pulley else P.layout
+
+
 class _NotConverged(Exception):
     """Newton did not converge from this start (internal: the caller tries another)."""
 
@@ -60,7 +67,8 @@ def _psi(lam, beta, L, t, der):
 
 @dataclass(frozen=True)
 class _Seg:
-    """A piece [p, q] of the loop: "stick", "slip" or "span", on arc 0, 1 or none (-1)."""
+    """A piece [p, q] of the loop: "stick", "slip" or "span", on arc ``arc`` (-1: a
+    span)."""
 
     p: float
     q: float
@@ -70,6 +78,7 @@ class _Seg:
     lam: float = 0.0  # slip: n = N - rho c^2 grows as exp(lam t)
     g: float = 0.0  # slip: theta'' - beta^2 theta = g n
     sign: float = 0.0  # slip: the sign of f
+    lever: float = 0.0  # arcs: the friction's signed lever, l times the pulley's side
 
     @property
     def length(self) -> float:
@@ -78,16 +87,27 @@ class _Seg:
 
 
 class _Loop:
-    """The pieces and the unknowns' layout at belt speed c and slip arcs d (None: adhesion).
+    """The pieces and the unknowns' layout at belt speed c and signed slip arcs d (None:
+    adhesion).
+
+    Arc i (pulley i of ``P.layout``, in the belt's order) is a stick piece, a slip piece
+    of length abs(d[i]) at its exit where f = sign(d[i]) mu_i p (Coulomb only) and the
+    span to pulley i + 1. A back-side pulley (side -1) touches the belt's other face:
+    the friction's lever about the middle line is -l there, in the moment (l f), the
+    bottom fibre's speed (l theta') and so in every piece's solution; alpha, which sees
+    l^2, is the same on every arc.
 
     Unknowns z: theta's (P, Q) of piece i at 2i, 2i + 1; then the strain at the start of
-    each slip and span piece (``ia``); then e_1, e_2 (``ie``); with adhesion, F_1, F_2
-    (``iF``). A form is a row r of n + 1 numbers, the value r[:n] @ z + r[n].
+    each slip and span piece (``ia``); then each arc's e_i (``ie``); with adhesion, each
+    exit's F_i (``iF``). A form is a row r of n + 1 numbers, the value r[:n] @ z + r[n].
     """
 
     def __init__(self, P: DriveParams, lever: float, c: float, d=None):
-        g = P.geometry
+        lay = P.layout
         self.P, self.l, self.c = P, lever, c
+        frame = _frame(P)
+        self.bounds, self.radii = frame.bounds, np.asarray(frame.radii)
+        self.arcs, self.loop_length = np.asarray(frame.arcs), frame.loop_length
         self.rc = P.rho * c * c
         self.B = P.b1 - self.rc
         self.A = P.a - P.I * c * c
@@ -102,17 +122,20 @@ class _Loop:
         self.beta = math.sqrt(P.b2 / A)
         self.alpha = math.sqrt(P.b2 / (A + lever * lever * self.B))
         self.coulomb = d is not None
-        e = g.bounds
+        e, n_arcs = self.bounds, len(lay)
         segs = []
-        for arc in (0, 1):
-            p, q, R = e[2 * arc], e[2 * arc + 1], g.radii[arc]
-            s = q - d[arc] if self.coulomb else q
-            segs.append(_Seg(p, s, "stick", arc, self.alpha))
+        for arc in range(n_arcs):
+            p, q, R = e[2 * arc], e[2 * arc + 1], self.radii[arc]
+            lv = lever * float(lay.sides[arc])
+            s = q - abs(d[arc]) if self.coulomb else q
+            segs.append(_Seg(p, s, "stick", arc, self.alpha, lever=lv))
             if self.coulomb:
-                sign = 1.0 if arc == 0 else -1.0
+                # the sign of a zero-length slip piece is immaterial: its (P, Q) absorb it
+                sign = 1.0 if d[arc] > 0 else -1.0
+                mu = P.mus[arc]
                 segs.append(_Seg(s, q, "slip", arc, self.beta,
-                                 lam=-sign * P.mu * P.b1 / (self.B * R),
-                                 g=-lever * sign * P.mu / (self.A * R), sign=sign))
+                                 lam=-sign * mu * P.b1 / (self.B * R),
+                                 g=-lv * sign * mu / (self.A * R), sign=sign, lever=lv))
             segs.append(_Seg(q, e[2 * arc + 2], "span", -1, self.beta))
         self.segs = segs
         n = 2 * len(segs)
@@ -121,10 +144,10 @@ class _Loop:
             if seg.kind != "stick":
                 self.ia[i] = n
                 n += 1
-        self.ie = (n, n + 1)
-        n += 2
-        self.iF = (n, n + 1) if not self.coulomb else None
-        self.n = n + (2 if not self.coulomb else 0)
+        self.ie = tuple(range(n, n + n_arcs))
+        n += n_arcs
+        self.iF = tuple(range(n, n + n_arcs)) if not self.coulomb else None
+        self.n = n + (n_arcs if not self.coulomb else 0)
 
     # forms -------------------------------------------------------------------------
     def _zero(self, t):
@@ -149,7 +172,7 @@ class _Loop:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         out = self._zero(t)
         if seg.kind == "stick":
-            out = -self.l * self.theta(i, t, 1)
+            out = -seg.lever * self.theta(i, t, 1)
             out[:, self.ie[seg.arc]] += 1.0
         elif seg.kind == "slip":
             out[:, self.ia[i]] = np.exp(seg.lam * t)
@@ -164,7 +187,7 @@ class _Loop:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         out = self._zero(t)
         if seg.kind == "stick":
-            out = -self.l * (self.theta(i, t) - self.theta(i, 0.0))
+            out = -seg.lever * (self.theta(i, t) - self.theta(i, 0.0))
             out[:, self.ie[seg.arc]] += t
         elif seg.kind == "slip":
             tE = t * _expm1_ratio(seg.lam * t)
@@ -179,33 +202,50 @@ class _Loop:
         seg = self.segs[i]
         t = np.atleast_1d(np.asarray(t, dtype=float))
         if seg.kind == "stick":
-            return self.B * self.l * self.alpha**2 * self.theta(i, t)
+            return self.B * seg.lever * self.alpha**2 * self.theta(i, t)
         if seg.kind == "slip":
-            R = self.P.geometry.radii[seg.arc]
             n = self.P.b1 * self.eps(i, t)
             n[:, -1] += self.P.N0 - self.rc
-            return seg.sign * self.P.mu / R * n
+            return seg.sign * self.P.mus[seg.arc] / self.radii[seg.arc] * n
         return self._zero(t)
 
     def pressure(self, i, t):
         """The contact pressure (N - rho c^2) / R on arc piece i at local t."""
-        R = self.P.geometry.radii[self.segs[i].arc]
+        R = self.radii[self.segs[i].arc]
         out = self.P.b1 / R * self.eps(i, t)
         out[:, -1] += (self.P.N0 - self.rc) / R
         return out
 
-    def fibre_speed(self, i, t):
-        """The bottom fibre's speed c (1 + N0/b1 + eps + l theta') on piece i at t."""
-        out = self.c * (self.eps(i, t) + self.l * self.theta(i, t, 1))
+    def fibre_speed(self, i, t, lever=None):
+        """The contact fibre's speed c (1 + N0/b1 + eps + l_i theta') on piece i at t,
+        l_i the arc's signed lever (``lever``: another's, e.g. for the fibre that left an
+        arc, on the span after it)."""
+        lever = self.segs[i].lever if lever is None else lever
+        out = self.c * (self.eps(i, t) + lever * self.theta(i, t, 1))
         out[:, -1] += self.c * (1.0 + self.P.N0 / self.P.b1)
         return out
 
+    def arc_force(self, arc):
+        """The friction's resultant on ``arc`` (N) as a form: -B times the strain's rise
+        over its pieces, and with adhesion its exit's concentrated force."""
+        out = self._zero([0.0])[0]
+        for i, seg in enumerate(self.segs):
+            if seg.arc == arc:
+                out -= self.B * (self.eps(i, seg.length)[0] - self.eps(i, 0.0)[0])
+        if not self.coulomb:
+            out[self.iF[arc]] += 1.0
+        return out
+
     # conditions --------------------------------------------------------------------
-    def conditions(self, omega1, M2):
-        """All conditions as forms (rows) and the indices of the three (Coulomb) or one
-        (adhesion) closing residual among them, with each row's scale (N)."""
+    def conditions(self, omega_d, loads):
+        """All conditions as forms (rows) and the indices of the closing residuals among
+        them (Coulomb: the closure, the length and each non-driver pulley's balance;
+        adhesion: the closure), with each row's scale (N).
+
+        ``omega_d`` is the driver's speed, ``loads`` each pulley's load torque M_i (N m;
+        0 at idlers, the driver's entry ignored)."""
         P, segs, b1 = self.P, self.segs, self.P.b1
-        R1, R2 = P.geometry.radii
+        drv = P.driver
         rows, scales = [], []
         for i, seg in enumerate(segs):
             j = (i + 1) % len(segs)
@@ -214,30 +254,31 @@ class _Loop:
             dth = self.theta(j, 0.0, 1) - self.theta(i, L, 1)
             ep = self.eps(j, 0.0) - self.eps(i, L)
             if not self.coulomb and seg.kind == "stick":  # an arc's exit
-                dth[0, self.iF[seg.arc]] += self.l / self.A
+                dth[0, self.iF[seg.arc]] += seg.lever / self.A
                 ep[0, self.iF[seg.arc]] += 1.0 / self.B
             rows += [th[0], dth[0], ep[0]]
             scales += [1.0, 1.0, b1]
         closure = len(rows) - 1  # the strain's continuity at x = Lambda = 0
-        length = sum(self.int_eps(i, seg.length)[0] for i, seg in enumerate(segs))
-        balance = self._zero([0.0])[0]
-        for i, seg in enumerate(segs):
-            if seg.arc == 1:
-                balance -= self.B * (self.eps(i, seg.length)[0] - self.eps(i, 0.0)[0])
-        if not self.coulomb:
-            balance[self.iF[1]] += 1.0
-        balance[-1] += M2 / R2
+        rows.append(sum(self.int_eps(i, seg.length)[0] for i, seg in enumerate(segs)))
+        scales.append(b1 / self.loop_length)
+        residual = [closure, len(rows) - 1]
+        for arc in range(len(self.radii)):
+            if arc != drv:  # the friction's resultant takes the load: R_i F_i = -M_i
+                balance = self.arc_force(arc)
+                balance[-1] += loads[arc] / self.radii[arc]
+                residual.append(len(rows))
+                rows.append(balance)
+                scales.append(1.0)
         pin = self._zero([0.0])[0]
-        pin[self.ie[0]] = 1.0
-        pin[-1] = -(omega1 * R1 / self.c - 1.0 - P.N0 / b1)
-        rows += [length, balance, pin]
-        scales += [b1 / P.geometry.loop_length, 1.0, b1]
-        residual = [closure, len(rows) - 3, len(rows) - 2] if self.coulomb else [closure]
-        return np.array(rows), np.array(scales), residual
+        pin[self.ie[drv]] = 1.0
+        pin[-1] = -(omega_d * self.radii[drv] / self.c - 1.0 - P.N0 / b1)
+        rows.append(pin)
+        scales.append(b1)
+        return np.array(rows), np.array(scales), residual if self.coulomb else [closure]
 
-    def solve(self, omega1, M2):
+    def solve(self, omega_d, loads):
         """The constants z and the closing residuals (N) at this c and these slip arcs."""
-        rows, scales, res = self.conditions(omega1, M2)
+        rows, scales, res = self.conditions(omega_d, loads)
         inner = np.setdiff1d(np.arange(len(rows)), res)
         M = rows[inner, :-1]
         b = -rows[inner, -1]
@@ -255,23 +296,41 @@ class _Loop:
 # Newton on the nonlinear unknowns
 
 
-def _unpack(P, mode, y):
-    """(c, d, M2 or None) of the iterated unknowns y in ``mode``."""
-    g = P.geometry
-    R1, R2 = g.radii
-    arcs = g.arcs
+def _signs(P: DriveParams, loads) -> np.ndarray:
+    """Each arc's slip sign: +1 on the driver (f drives the belt), -1 on a loaded pulley
+    (f brakes it), 0 where the sign is itself unknown: an unloaded pulley of a drive on
+    more than two pulleys (an idler). Its stick zone's friction B l_i theta'' has a
+    resultant of either sign, which the slip arc balances; its slip variable is signed
+    and passes through 0 (a slip arc of length 0, whose sign is immaterial)."""
+    out = np.where(np.asarray(loads, dtype=float) > 0, -1.0, 0.0)
+    if P.two_pulley:  # the two-pulley drive's driven pulley slips backwards, even unloaded
+        out[:] = -1.0
+    out[P.driver] = 1.0
+    return out
+
+
+def _unpack(P, mode, y, loads):
+    """(c, signed slip arcs d, loads) of the iterated unknowns y in ``mode``: "stick"
+    (y = c), "load" (y = c and mu_i d_i / R_i per pulley), or the two-pulley drive's
+    capacity modes "cap1" and "cap2" (a slip arc over its whole wrap, the load
+    M2 = y[1 + k] R2 N0 unknown in its place)."""
     if mode == "stick":
-        return y[0], None, None
+        return y[0], None, loads
+    frame = _frame(P)
+    mus = np.asarray(P.mus, dtype=float)
+    sg = _signs(P, loads)
+    d = np.where(sg == 0, 1.0, sg) * np.asarray(y[1:]) * frame.radii / mus
     if mode == "load":
-        return y[0], (y[1] * R1 / P.mu, y[2] * R2 / P.mu), None
-    if mode == "cap1":  # the driver slides on its whole wrap; the load is unknown
-        return y[0], (arcs[0], y[2] * R2 / P.mu), y[1] * R2 * P.N0
-    return y[0], (y[1] * R1 / P.mu, arcs[1]), y[2] * R2 * P.N0
+        return y[0], d, loads
+    k = 0 if mode == "cap1" else 1  # the two-pulley drive's driver sliding, or its driven
+    d[k] = sg[k] * frame.arcs[k]
+    return y[0], d, (0.0, y[1 + k] * frame.radii[1] * P.N0)
 
 
-def _newton(P, lever, omega1, M2, mode, y0):
+def _newton(P, lever, omega1, loads, mode, y0):
     """Damped Newton on the closing residuals with a central-difference Jacobian; the
-    unknowns other than c (slip-arc variables, a load) are kept >= 0.
+    unknowns other than c (slip-arc variables, a load) are kept >= 0 but for the signed
+    slip variables of idlers (:func:`_signs`).
 
     Converged when the scaled step falls below STEP_TOL, or below FLOOR_STEP where no
     step lowers the residual any more (its round-off floor, which the exponentials'
@@ -279,13 +338,17 @@ def _newton(P, lever, omega1, M2, mode, y0):
     """
     y = np.array(y0, dtype=float)
     scale = np.array([y[0]] + [1.0] * (len(y) - 1))
+    keep = np.ones(len(y), bool)
+    keep[0] = False
+    if mode == "load":
+        keep[1:] = _signs(P, loads) != 0
 
     def evaluate(y):
-        c, d, m2 = _unpack(P, mode, y)
+        c, d, m = _unpack(P, mode, y, loads)
         try:
             with np.errstate(all="ignore"):
                 loop = _Loop(P, lever, c, d)
-                z, r = loop.solve(omega1, M2 if m2 is None else m2)
+                z, r = loop.solve(omega1, m)
         except (NoSolutionError, np.linalg.LinAlgError):
             return None
         r = r / P.N0
@@ -314,7 +377,7 @@ def _newton(P, lever, omega1, M2, mode, y0):
         n0, step, new = float(np.linalg.norm(r)), 1.0, None
         while step >= 1e-4:
             trial = y + step * dy
-            trial[1:] = np.maximum(trial[1:], 0.0)
+            trial[keep] = np.maximum(trial[keep], 0.0)
             new = evaluate(trial)
             if new is not None and float(np.linalg.norm(new[2])) < (1 - 1e-4 * step) * n0:
                 break
@@ -335,12 +398,12 @@ def _newton(P, lever, omega1, M2, mode, y0):
     raise _NotConverged(f"no convergence in {MAX_ITERATIONS} iterations")
 
 
-def _converge(P, omega1, M2, mode, y0):
+def _converge(P, omega1, loads, mode, y0):
     """Newton at the full lever, falling back on a continuation in the lever from the
     string (lever 0), where y0 is exact."""
     lever = P.lever
     try:
-        return _newton(P, lever, omega1, M2, mode, y0)
+        return _newton(P, lever, omega1, loads, mode, y0)
     except _NotConverged:
         if lever == 0.0:
             raise
@@ -348,7 +411,7 @@ def _converge(P, omega1, M2, mode, y0):
     while t < 1.0:
         dt = min(dt, 1.0 - t)
         try:
-            loop, z, y_new = _newton(P, (t + dt) * lever, omega1, M2, mode, y)
+            loop, z, y_new = _newton(P, (t + dt) * lever, omega1, loads, mode, y)
         except _NotConverged:
             dt /= 2
             if dt < 1.0 / 16:

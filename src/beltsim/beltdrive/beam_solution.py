@@ -10,21 +10,24 @@ import numpy as np
 
 from ..errors import NoSolutionError
 from .analytic import LiftOffError
-from .beam_loop import _graded, _Loop, _Seg
-from .figures import layout_summary
+from .beam_loop import _frame, _graded, _Loop, _Seg
+from .figures import hub_loads, layout_summary
 from .params import DriveParams
 
 
 class BeamSolution:
-    """The beam's steady state of a drive (SI units; arcs in rad); the interface of
-    :class:`~beltsim.beltdrive.analytic.StringSolution` where it applies.
+    """The beam's steady state of a drive on N pulleys (SI units; arcs in rad); the
+    interface of :class:`~beltsim.beltdrive.creep.SerpentineSolution` (and for two
+    pulleys of :class:`~beltsim.beltdrive.analytic.StringSolution`) where it applies.
 
+    ``loads`` are the pulleys' load torques M_i (N m, the driver's entry ignored).
     Fields take loop coordinates x (taken modulo Lambda) and give the value downstream at
     a jump.
     """
 
-    def __init__(self, P: DriveParams, omega1: float, M2: float, loop: _Loop, z):
-        self.P, self.omega1, self.M2 = P, omega1, M2
+    def __init__(self, P: DriveParams, omega1: float, loads, loop: _Loop, z):
+        self.P, self.omega1 = P, omega1
+        self.loads = np.asarray(loads, dtype=float)
         self._loop = loop
         self._zz = np.append(z, 1.0)
         self._starts = np.array([seg.p for seg in loop.segs])
@@ -33,7 +36,7 @@ class BeamSolution:
                 for i, seg in enumerate(loop.segs)]
         self._u0 = np.concatenate([[0.0], np.cumsum(ends)[:-1]])
         xq, wq = self._quadrature()
-        self._u_mean = float(np.sum(wq * self._field(xq, "u"))) / P.geometry.loop_length
+        self._u_mean = float(np.sum(wq * self._field(xq, "u"))) / self._loop.loop_length
 
     # scalars -----------------------------------------------------------------------
     @property
@@ -42,99 +45,134 @@ class BeamSolution:
         return self._loop.c
 
     @property
+    def M2(self) -> float:
+        """The driven pulley's load (two-pulley drives, N m)."""
+        return float(self.loads[1])
+
+    @property
     def lever(self) -> float:
-        """The friction's lever l (m) the solution was computed with."""
+        """The friction's lever l (m) the solution was computed with (on the belt's
+        inner face; -l on a back-side pulley's arc)."""
         return self._loop.l
 
     @property
-    def strain_constants(self) -> tuple[float, float]:
-        """(e_1, e_2): the stick zones' eps + l theta' on the driver and the driven arc."""
+    def layout(self):
+        """The layout solved (with a tensioner's arm at the drive's angle)."""
+        return self.P.layout
+
+    @property
+    def strain_constants(self) -> tuple[float, ...]:
+        """Each arc's e_i: its stick zone's eps + l_i theta'."""
         return tuple(float(self._zz[i]) for i in self._loop.ie)
 
     @property
-    def omega2(self) -> float:
-        """The driven pulley's speed (rad/s): its rim moves with the stuck belt's fibre."""
+    def speeds(self) -> np.ndarray:
+        """Each pulley's speed (rad/s), its rim moving with the stuck belt's contact
+        fibre c (1 + N0/b1 + e_i); the driver's is omega1."""
         P = self.P
-        return self.c * (1.0 + P.N0 / P.b1 + self.strain_constants[1]) / P.geometry.R2
+        out = self.c * (1.0 + P.N0 / P.b1 + np.array(self.strain_constants)) / self._loop.radii
+        out[P.driver] = self.omega1
+        return out
+
+    @property
+    def omega2(self) -> float:
+        """The driven pulley's speed (two-pulley drives, rad/s)."""
+        return float(self.speeds[1])
 
     @property
     def speed_ratio(self) -> float:
-        """omega2 R2 / (omega1 R1)."""
-        R1, R2 = self.P.geometry.radii
+        """omega2 R2 / (omega1 R1) (two-pulley drives)."""
+        R1, R2 = self._loop.radii
         return self.omega2 * R2 / (self.omega1 * R1)
 
     @property
-    def stick_ends(self) -> tuple[float, float]:
-        """Loop coordinates where the driver's and the driven arc's slip arcs begin (the
-        arcs' exits for perfect adhesion)."""
-        segs = self._loop.segs
-        return segs[0].q, segs[3 if self._loop.coulomb else 2].q
+    def stick_ends(self) -> tuple[float, ...]:
+        """Loop coordinates where each arc's slip arc begins (its exit for perfect
+        adhesion)."""
+        return tuple(seg.q for seg in self._loop.segs if seg.kind == "stick")
 
     @property
-    def slip_arcs(self) -> tuple[float, float]:
-        """The slip arcs (rad) of the driver and the driven pulley."""
-        g = self.P.geometry
-        e = g.bounds
-        s1, s2 = self.stick_ends
-        return (e[1] - s1) / g.R1, (e[3] - s2) / g.R2
+    def slip_arcs(self) -> tuple[float, ...]:
+        """Each pulley's slip arc (rad), its length whichever way it slips."""
+        loop = self._loop
+        exits = loop.bounds[1::2]
+        return tuple(float((exits[i] - s) / loop.radii[i])
+                     for i, s in enumerate(self.stick_ends))
 
     @property
-    def concentrated(self) -> tuple[float, float]:
-        """Concentrated friction forces (N) at the driver's and the driven arc's exits:
-        nonzero for perfect adhesion only."""
+    def slip_signs(self) -> tuple[float, ...]:
+        """The sign of each arc's friction on its slip arc (+1 along the motion, as on
+        the driver; 0 for perfect adhesion)."""
+        return tuple(seg.sign for seg in self._loop.segs if seg.kind == "slip") \
+            if self._loop.coulomb else (0.0,) * len(self.P.layout)
+
+    @property
+    def concentrated(self) -> tuple[float, ...]:
+        """Concentrated friction forces (N) at each arc's exit: nonzero for perfect
+        adhesion only."""
         if self._loop.coulomb:
-            return 0.0, 0.0
+            return (0.0,) * len(self.P.layout)
         return tuple(float(self._zz[i]) for i in self._loop.iF)
 
     def _arc_force(self, arc) -> float:
-        """The friction force (N) on arc 0 or 1, distributed and concentrated."""
-        loop = self._loop
-        total = self.concentrated[arc]
-        for i, seg in enumerate(loop.segs):
-            if seg.arc == arc:
-                total -= loop.B * float((loop.eps(i, seg.length)[0]
-                                         - loop.eps(i, 0.0)[0]) @ self._zz)
-        return total
+        """The friction force (N) on ``arc``, distributed and concentrated."""
+        return float(self._loop.arc_force(arc) @ self._zz)
+
+    @property
+    def arc_torques(self) -> np.ndarray:
+        """R_i times the friction's resultant on each arc (N m): what each pulley puts
+        into the belt (the driver's > 0, a loaded pulley's -M_i, an idler's 0)."""
+        return np.array([self._arc_force(i) for i in range(len(self.P.layout))]) \
+            * self._loop.radii
+
+    @property
+    def torques(self) -> np.ndarray:
+        """Each pulley's torque (N m) as the creep theory reports them: the driver's
+        supplied, each other one's consumed (its load; 0 at idlers)."""
+        out = -self.arc_torques
+        out[self.P.driver] *= -1.0
+        return out
 
     @property
     def driver_torque(self) -> float:
-        """M1 = R1 times the friction force on the driver's arc (N m)."""
-        return self.P.geometry.R1 * self._arc_force(0)
+        """M_d = R_d times the friction force on the driver's arc (N m)."""
+        return float(self.arc_torques[self.P.driver])
 
     @property
     def efficiency(self) -> float:
-        """M2 omega2 / (M1 omega1) (1 when unloaded)."""
-        return self.M2 * self.omega2 / (self.driver_torque * self.omega1) \
-            if self.M2 > 0 else 1.0
+        """sum_i M_i omega_i / (M_d omega_d) (1 when unloaded)."""
+        rest = np.arange(len(self.loads)) != self.P.driver
+        out = float(np.dot(self.loads[rest], self.speeds[rest]))
+        return out / (self.driver_torque * self.omega1) if out > 0 else 1.0
+
+    @property
+    def slip_powers(self) -> np.ndarray:
+        """The friction's dissipation on each arc (W): minus the integral of f v_rel
+        over its slip arc, and for perfect adhesion its exit's concentrated force times
+        minus the mean of the sliding speeds on the two sides of the exit (the module
+        docstring of :mod:`beltsim.beltdrive.beam`)."""
+        loop = self._loop
+        out = np.zeros(len(self.P.layout))
+        for i, seg in enumerate(loop.segs):
+            if loop.coulomb and seg.kind == "slip" and seg.length > 0:
+                t, w = _graded(seg)
+                f = loop.friction(i, t) @ self._zz
+                v = loop.fibre_speed(i, t) @ self._zz - self._rim(seg.arc)
+                out[seg.arc] -= float(np.sum(w * f * v))
+            elif not loop.coulomb and seg.kind == "stick":
+                rim = self._rim(seg.arc)
+                before = float(loop.fibre_speed(i, seg.length)[0] @ self._zz) - rim
+                after = float(loop.fibre_speed(i + 1, 0.0, seg.lever)[0] @ self._zz) - rim
+                out[seg.arc] -= self.concentrated[seg.arc] * 0.5 * (before + after)
+        return out
 
     @property
     def slip_power(self) -> float:
-        """The friction's dissipation (W): minus the integral of f v_rel over the slip
-        arcs, and for perfect adhesion each concentrated force times minus the mean of
-        the sliding speeds on the two sides of its exit (the module docstring)."""
-        loop = self._loop
-        if loop.coulomb:
-            total = 0.0
-            for i, seg in enumerate(loop.segs):
-                if seg.kind == "slip" and seg.length > 0:
-                    t, w = _graded(seg)
-                    rim = self._rim(seg.arc)
-                    f = loop.friction(i, t) @ self._zz
-                    v = loop.fibre_speed(i, t) @ self._zz - rim
-                    total -= float(np.sum(w * f * v))
-            return total
-        total = 0.0
-        for arc, i in ((0, 0), (1, 2)):
-            seg = loop.segs[i]
-            rim = self._rim(arc)
-            before = float(loop.fibre_speed(i, seg.length)[0] @ self._zz) - rim
-            after = float(loop.fibre_speed(i + 1, 0.0)[0] @ self._zz) - rim
-            total -= self.concentrated[arc] * 0.5 * (before + after)
-        return total
+        """The friction's total dissipation (W)."""
+        return float(self.slip_powers.sum())
 
     def _rim(self, arc) -> float:
-        R = self.P.geometry.radii[arc]
-        return (self.omega1 if arc == 0 else self.omega2) * R
+        return float(self.speeds[arc] * self._loop.radii[arc])
 
     def _span_mean(self, i) -> float:
         seg = self._loop.segs[i]
@@ -142,42 +180,54 @@ class BeamSolution:
         return self.P.N0 + self.P.b1 * mean_eps
 
     @property
+    def tensions(self) -> np.ndarray:
+        """Each span's axial force N (N), span j from pulley j to j + 1: its mean,
+        constant there (no friction acts on a span, so B eps' = 0; theta's boundary
+        layers at its ends leave N alone)."""
+        return np.array([self._span_mean(i) for i, seg in enumerate(self._loop.segs)
+                         if seg.kind == "span"])
+
+    @property
     def tight_tension(self) -> float:
-        """The mean axial force N (N) over the tight span (constant there: no friction acts
-        on a span, so B eps' = 0; theta's boundary layers at its ends leave N alone)."""
+        """The tight span's N (two-pulley drives: the span into the driver)."""
         return self._span_mean(len(self._loop.segs) - 1)
 
     @property
     def slack_tension(self) -> float:
-        """The mean axial force N (N) over the slack span."""
+        """The slack span's N (two-pulley drives: the span out of the driver)."""
         return self._span_mean(2 if self._loop.coulomb else 1)
 
     @property
-    def speeds(self) -> tuple[float, float]:
-        """The driver's and the driven pulley's speeds (rad/s)."""
-        return self.omega1, self.omega2
+    def hub_loads(self) -> np.ndarray:
+        """The belt's force on each pulley's bearing (N, rows (Fx, Fy)), from the span
+        tensions as the creep theory and a run's summary take it
+        (:func:`~beltsim.beltdrive.figures.hub_loads`)."""
+        return hub_loads(self.P.layout, self.P.rho, self.c, self.tensions)
 
     def summary(self) -> dict:
-        """The drive's figures, under the run summary's names."""
+        """The drive's figures, under the run summary's names: the spans' and pulleys'
+        (:func:`~beltsim.beltdrive.figures.layout_summary`), the totals, a tensioner's
+        arm and, on two pulleys, the two-pulley drive's own figures."""
+        P = self.P
+        out = {"belt_speed": self.c, "driver_torque": self.driver_torque,
+               "efficiency": self.efficiency, "slip_power": self.slip_power}
         arcs = self.slip_arcs
-        out = {
-            "tight_tension": self.tight_tension, "slack_tension": self.slack_tension,
-            "belt_speed": self.c, "driven_speed": self.omega2,
-            "speed_ratio": self.speed_ratio, "slip_arc_driver": arcs[0],
-            "slip_arc_driven": arcs[1], "driver_torque": self.driver_torque,
-            "efficiency": self.efficiency, "slip_power": self.slip_power,
-        }
+        if P.two_pulley:
+            out |= {"tight_tension": self.tight_tension,
+                    "slack_tension": self.slack_tension, "driven_speed": self.omega2,
+                    "speed_ratio": self.speed_ratio, "slip_arc_driver": arcs[0],
+                    "slip_arc_driven": arcs[1]}
         out = {k: float(v) for k, v in out.items()}
-        return out | layout_summary(
-            self.P.layout, ("driver", "driven"), self.P.rho, self.c,
-            (out["slack_tension"], out["tight_tension"]), self.speeds, arcs,
-            (self.driver_torque, self.M2))
+        out |= layout_summary(P.layout, P.roles, P.rho, self.c, self.tensions,
+                              self.speeds, arcs, self.torques,
+                              **({} if P.two_pulley else {"slip_power": self.slip_powers}))
+        return out | P.arm_figures()
 
     # fields ------------------------------------------------------------------------
     def _field(self, x, name):
         loop = self._loop
         x = np.asarray(x, dtype=float)
-        xs = np.mod(x.ravel(), self.P.geometry.loop_length)
+        xs = np.mod(x.ravel(), self._loop.loop_length)
         idx = np.clip(np.searchsorted(self._starts, xs, side="right") - 1, 0,
                       len(loop.segs) - 1)
         out = np.zeros_like(xs)
@@ -216,9 +266,8 @@ class BeamSolution:
 
     def pressure(self, x) -> np.ndarray:
         """Contact pressure (N - rho c^2) / R_i (N/m) on the arcs, 0 on the spans."""
-        g = self.P.geometry
-        seg = g.segment_of(x)
-        R = np.where(seg == 0, g.R1, g.R2)
+        seg = _frame(self.P).segment_of(x)
+        R = self._loop.radii[seg // 2]
         return np.where(seg % 2 == 0, (self.tension(x) - self._loop.rc) / R, 0.0)
 
     def theta(self, x) -> np.ndarray:
@@ -242,7 +291,7 @@ class BeamSolution:
     def grid(self, n: int = 400) -> np.ndarray:
         """Sorted loop coordinates that resolve every boundary layer: n even points and
         the graded quadrature's nodes."""
-        lam = self.P.geometry.loop_length
+        lam = self._loop.loop_length
         return np.unique(np.concatenate([np.linspace(0.0, lam, n, endpoint=False),
                                          self._quadrature()[0]]))
 
@@ -260,50 +309,49 @@ class BeamSolution:
     def _check(self):
         """Raise where the solution breaks its model: no contact pressure, a slip arc
         outside its wrap, friction above mu p in a stick zone or sliding along f."""
-        loop, P, g = self._loop, self.P, self.P.geometry
-        names = ("driver", "driven")
-        for arc in (0, 1):
-            for i, seg in enumerate(loop.segs):
-                if seg.arc != arc:
-                    continue
-                t = np.concatenate([[0.0, seg.length], _graded(seg)[0]])
-                p = loop.pressure(i, t) @ self._zz
-                if not np.min(p) > 0:
-                    raise LiftOffError(
-                        f"drive.installation_tension: {P.N0:g} N leaves the {names[arc]} arc "
-                        f"without contact pressure (min {np.min(p):.4g} N/m) at this load and "
-                        f"speed: the belt would lift off, which this model does not describe")
-                if not loop.coulomb:
-                    continue
-                f = loop.friction(i, t) @ self._zz
-                if seg.kind == "stick":
-                    ratio = np.max(np.abs(f) / (P.mu * p))
-                    if ratio > 1.0 + 1e-9:
-                        raise NoSolutionError(
-                            f"beam drive: the {names[arc]} arc's stick zone needs friction "
-                            f"{ratio:.6g} times mu p: the stick-then-slip layout does not "
-                            f"hold")
-                else:
-                    v = loop.fibre_speed(i, t) @ self._zz - self._rim(arc)
-                    # the creep's scale, and the round-off of v_rel as a difference of speeds
-                    tol = self.c * (1e-9 * abs(np.diff(self.strain_constants)[0]) + 1e-13)
-                    if np.max(seg.sign * v) > tol:
-                        raise NoSolutionError(
-                            f"beam drive: the belt slides along its friction on the "
-                            f"{names[arc]} arc's slip arc (v_rel {np.max(seg.sign * v):.3g} "
-                            f"m/s the wrong way): the stick-then-slip layout does not hold")
+        loop, P, lay = self._loop, self.P, self.P.layout
+        names = [f"{r} pulley {n!r}" for r, n in zip(P.roles, lay.names)]
+        # the creep's scale, and the round-off of v_rel as a difference of speeds
+        tol = self.c * (1e-9 * float(np.ptp(self.strain_constants)) + 1e-13)
+        for i, seg in enumerate(loop.segs):
+            arc = seg.arc
+            if arc < 0:
+                continue
+            t = np.concatenate([[0.0, seg.length], _graded(seg)[0]])
+            p = loop.pressure(i, t) @ self._zz
+            if not np.min(p) > 0:
+                raise LiftOffError(
+                    f"drive.installation_tension: {P.N0:g} N leaves the {names[arc]}'s arc "
+                    f"without contact pressure (min {np.min(p):.4g} N/m) at this load and "
+                    f"speed: the belt would lift off, which this model does not describe")
+            if not loop.coulomb:
+                continue
+            f = loop.friction(i, t) @ self._zz
+            if seg.kind == "stick":
+                ratio = np.max(np.abs(f) / (P.mus[arc] * p))
+                if ratio > 1.0 + 1e-9:
+                    raise NoSolutionError(
+                        f"beam drive: the {names[arc]}'s stick zone needs friction "
+                        f"{ratio:.6g} times mu p: the stick-then-slip layout does not hold")
+            else:
+                v = loop.fibre_speed(i, t) @ self._zz - self._rim(arc)
+                if np.max(seg.sign * v) > tol:
+                    raise NoSolutionError(
+                        f"beam drive: the belt slides along its friction on the "
+                        f"{names[arc]}'s slip arc (v_rel {np.max(seg.sign * v):.3g} m/s "
+                        f"the wrong way): the stick-then-slip layout does not hold")
         if loop.coulomb:
-            tol = 1e-12 * g.loop_length
+            slack = 1e-12 * lay.loop_length
             for arc, d in enumerate(self.slip_arcs):
-                if not -tol <= d * g.radii[arc] <= g.arcs[arc] + tol:
-                    raise NoSolutionError(f"beam drive: the {names[arc]} slip arc "
+                if not -slack <= d * loop.radii[arc] <= loop.arcs[arc] + slack:
+                    raise NoSolutionError(f"beam drive: the {names[arc]}'s slip arc "
                                           f"{d:.6g} rad lies outside its wrap")
 
 
 def _loop_quadrature(*sols):
     """Graded Gauss nodes over the loop, split at every piece end of the solutions."""
     breaks = np.unique(np.concatenate([[seg.p for seg in s._loop.segs] + [
-        s.P.geometry.loop_length] for s in sols]))
+        s._loop.loop_length] for s in sols]))
     k = max(s._loop.alpha for s in sols) + max(s._loop.beta for s in sols)
     xs, ws = [], []
     for a, b in zip(breaks[:-1], breaks[1:]):

@@ -40,6 +40,7 @@ import numpy as np
 from ..errors import NoSolutionError, SceneError
 from .analytic import GrossSlipError, LiftOffError, brentq
 from .figures import hub_loads, layout_summary
+from .params import DriveParams
 from .pulleys import PulleyLayout
 from .tensioner import Tensioner, equilibrium
 
@@ -100,6 +101,18 @@ class SerpentineData:
     def unstretched_length(self) -> float:
         """L0 = Lambda0 (1 - N0 / b1) (m), Lambda0 the drawn layout's loop length."""
         return self.layout.loop_length * (1.0 - self.N0 / self.b1)
+
+
+def serpentine_data(P: DriveParams) -> SerpentineData:
+    """The creep theory's data of a drive (its final speeds and loads; the layout as
+    drawn, with a tensioner's arm at its drawn angle)."""
+    if P.tensioner is not None and P.arm_turn:
+        P = P.at_arm(-P.arm_turn)
+    return SerpentineData(layout=P.layout, b1=P.b1, rho=P.rho,
+                          mu=None if P.mu is None else P.mus, N0=P.N0,
+                          driver=P.driver, omega=P.omega1,
+                          loads=tuple(p.final_load for p in P.pulleys),
+                          tensioner=P.tensioner)
 
 
 def _tensions(d: SerpentineData, layout: PulleyLayout, loads, Te):

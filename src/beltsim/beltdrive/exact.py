@@ -1,27 +1,16 @@
 """A drive's exact steady states, whatever its layout: the string's creep theory (the
 two-pulley closed form of :mod:`~beltsim.beltdrive.analytic`, or its N-pulley form of
-:mod:`~beltsim.beltdrive.creep`) and the beam's (:mod:`~beltsim.beltdrive.beam`, two
-pulleys)."""
+:mod:`~beltsim.beltdrive.creep`) and the beam's (:mod:`~beltsim.beltdrive.beam`, on any
+layout, with a tensioner's arm at rest by the same search as the creep theory's)."""
 
 from __future__ import annotations
 
 from ..errors import NoSolutionError
 from .analytic import solve_string
 from .beam import solve_beam
-from .creep import SerpentineData, solve_serpentine
+from .creep import serpentine_data, solve_serpentine
 from .params import DriveParams
-
-
-def serpentine_data(P: DriveParams) -> SerpentineData:
-    """The creep theory's data of a drive (its final speeds and loads; the layout as
-    drawn, with a tensioner's arm at its drawn angle)."""
-    if P.tensioner is not None and P.arm_turn:
-        P = P.at_arm(-P.arm_turn)
-    return SerpentineData(layout=P.layout, b1=P.b1, rho=P.rho,
-                          mu=None if P.mu is None else P.mus, N0=P.N0,
-                          driver=P.driver, omega=P.omega1,
-                          loads=tuple(p.final_load for p in P.pulleys),
-                          tensioner=P.tensioner)
+from .tensioner import equilibrium
 
 
 def string_state(P: DriveParams):
@@ -37,19 +26,37 @@ def string_state(P: DriveParams):
     return solve_serpentine(serpentine_data(P))
 
 
+def beam_state(P: DriveParams):
+    """The beam's exact steady state of a drive; with a tensioner, its arm at rest: the
+    root of the arm's torque (:func:`~beltsim.beltdrive.tensioner.equilibrium`, the
+    creep theory's search) over beam states of the same belt on the turned layouts,
+    started from the creep theory's rest angle (the two differ by O(l))."""
+    if P.tensioner is None:
+        return solve_beam(P)
+    drawn = P.at_arm(-P.arm_turn) if P.arm_turn else P
+    ten = drawn.tensioner
+    try:
+        beta0 = string_state(drawn).arm_travel
+    except NoSolutionError:
+        beta0 = 0.0
+    # the beam's rest angle is within O(l) of the string's: a small first step
+    # brackets it at once
+    _, sol = equilibrium(ten, drawn.layout, lambda beta: solve_beam(drawn.at_arm(beta)),
+                         lambda sol: sol.hub_loads[ten.index], beta0, step=1e-6,
+                         xtol=1e-13)
+    return sol
+
+
 def exact_state(P: DriveParams):
     """The exact steady state a drive's run is compared with: the beam's for the beam
-    model, the creep theory's for the string.
+    model (:func:`beam_state`), the creep theory's for the string.
 
     Raises
     ------
     NoSolutionError
-        The drive has no steady state (gross slip, lift-off), or it is a beam on more
-        than two pulleys, whose exact steady state is not derived yet.
+        The drive has no steady state (gross slip, lift-off), or none of the beam's
+        stick-then-slip layout.
     """
     if P.model == "beam":
-        if not P.two_pulley:
-            raise NoSolutionError("the beam's exact steady state is derived for two "
-                                  "pulleys only; this drive has none to compare with")
-        return solve_beam(P)
+        return beam_state(P)
     return string_state(P)
