@@ -61,6 +61,12 @@ class BeamSolution:
         return self.P.layout
 
     @property
+    def arm_travel(self) -> float | None:
+        """The tensioner arm's turn into the belt from its drawn angle (rad), None
+        without a tensioner (the creep solution's property of the same name)."""
+        return None if self.P.tensioner is None else self.P.arm_turn
+
+    @property
     def strain_constants(self) -> tuple[float, ...]:
         """Each arc's e_i: its stick zone's eps + l_i theta'."""
         return tuple(float(self._zz[i]) for i in self._loop.ie)

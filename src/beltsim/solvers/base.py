@@ -225,17 +225,33 @@ def _arm_reference(scene):
     laid: the exact steady state's rest angle (the creep theory's where the model has
     none), so that the run's own rest angle, near it, is read on that geometry; the
     drawn angle where the drive has no steady state (a run into gross slip)."""
+    data = scene.to_dict()
+    data.pop("numerics", None)  # the exact state is the physics'
+    key = repr(data)
+    if key not in _REST_TRAVEL:
+        if len(_REST_TRAVEL) >= 16:
+            _REST_TRAVEL.pop(next(iter(_REST_TRAVEL)))
+        _REST_TRAVEL[key] = _rest_travel(scene.params)
+    travel = _REST_TRAVEL[key]
+    return scene if travel is None else scene.at_arm(travel - scene.params.arm_turn)
+
+
+#: the exact rest angles of the last scenes' physics (the beam's arm search takes seconds)
+_REST_TRAVEL: dict[str, float | None] = {}
+
+
+def _rest_travel(P) -> float | None:
+    """The exact rest angle's turn from the drawn angle (rad; None without a steady
+    state)."""
     from ..beltdrive.exact import exact_state, string_state
     from ..errors import NoSolutionError
 
-    P = scene.params
     for solve in (exact_state, string_state):
         try:
-            travel = solve(P).arm_travel
+            return solve(P).arm_travel
         except NoSolutionError:
             continue
-        return scene.at_arm(travel - P.arm_turn)
-    return scene
+    return None
 
 
 def discretise(scene, grid=None) -> Discretisation:
