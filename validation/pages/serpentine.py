@@ -1,7 +1,7 @@
 """Page: serpentine drives (N pulleys, back-side idlers, a tensioner's arm) against the
 N-pulley creep theory: steady ladders and their orders, the default grid's errors and
-the steady solve's time, a start-up from rest with its power balance, and gross slip at
-a named pulley."""
+the steady solve's time, a start-up from rest with its power balance, gross slip at a
+named pulley, the forced response, and the tensioner's arm in motion."""
 
 from __future__ import annotations
 
@@ -273,6 +273,111 @@ def forced(page: Page, quick: bool) -> None:
                 "periodic runs (circles)")
 
 
+#: the arm's forced response: frequencies (Hz) of the periodic runs with the moving arm,
+#: and the figures compared with the linearisation (the arm's two spans and its angle)
+ARM_FORCED = {False: (20.0, 50.0, 80.0, 130.0), True: (20.0, 80.0)}
+ARM_KEYS = ("tension[steering-tensioner]", "tension[tensioner-pump]", "arm_travel")
+
+
+def arm_motion(page: Page, quick: bool) -> None:
+    """The tensioner's arm in transients: a start-up, the forced response with the arm
+    against the linearisation, and its rotational modes against the discrete model."""
+    import matplotlib.pyplot as plt
+
+    from beltsim.beltdrive.rotational import adhesion_limit, rotational_model
+    from beltsim.physics.loop_modes import drive_modes
+
+    name = SCENES[2]
+    elements = QUICK_ELEMENTS if quick else DEFAULT_ELEMENTS
+    sets = [("numerics.integrator", "esdirk3"), ("numerics.elements", elements)]
+    page.para(
+        f"`{name}` from rest by esdirk3 on {elements} elements: the drive at rest with the "
+        "arm settled under the installation tension, then the crankshaft and the loads "
+        "ramped up; the arm's angle and rate are two unknowns of the loop (theory: "
+        "\"The arm in a transient\"). The end state against the creep theory, as the "
+        "steady solve's (its search for the rest angle). Commands: "
+        + _cmd(name, "numerics.integrator=esdirk3", f"numerics.elements={elements}")
+        + " and the same with `numerics.integrator=steady`.")
+    r = beltsim.run(shipped_scene(name, sets), raise_on_failure=False)
+    st = beltsim.run(shipped_scene(name, [STEADY, ("numerics.elements", elements)]),
+                     raise_on_failure=False)
+    e, es = r.errors() or {}, st.errors() or {}
+    status = r.status.value if r.converged else page.fail(
+        f"arm start-up: {r.status.value} ({r.reason})")
+    page.table(["quantity", "start-up", "steady solve"], [
+        ["status", status, st.status.value],
+        ["end time [s]", f"{r.simulated_time:.4g}", ""],
+        ["steps (rejected)", f"{r.statistics['steps']} ({r.statistics.get('rejected_steps')})",
+         f"{st.statistics.get('arm_solves')} steady solves"],
+        ["wall [s]", f"{r.wall_time:.3g}", f"{st.wall_time:.3g}"],
+        *([ERRORS[k], fmt(e.get(k), ".3e"), fmt(es.get(k), ".3e")]
+          for k in ("span_tension", "hub_load", "slip_arc", "arm_travel"))])
+    h = r.history
+    fig, ax = plt.subplots(figsize=(7.5, 3.5), constrained_layout=True)
+    ax.plot(h["t"], h["arm_travel"], label="start-up (esdirk3)")
+    ax.axhline(string_state(r.scene.params).arm_travel, ls="--", color="k",
+               label="creep theory's rest angle")
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("arm travel [rad]")
+    ax.legend(fontsize=8)
+    page.figure(fig, "arm_startup", f"{name}: the arm's travel into the belt from its drawn "
+                "angle through the start-up")
+
+    tanh = [("numerics.friction_law", "tanh"), *sets]
+    scene = shipped_scene(name, tanh)
+    freqs = ARM_FORCED[quick]
+    page.para(
+        f"The crankshaft's speed fluctuating by {FLUCTUATION:g} rad/s with the arm free: "
+        "periodic runs with the moving arm against the drive linearised about its steady "
+        "state with the arm's angle among its unknowns (`beltsim.forced_response`, "
+        "`ForcedResponse.arm`), for the arm's two spans and its angle, the tanh law. "
+        f"Agreement required: {FORCED_TOL:.0%}. Commands: "
+        + _cmd(name, "numerics.friction_law=tanh", "numerics.integrator=esdirk3",
+               f"numerics.elements={elements}",
+               "'pulley.crankshaft.speed={mean = 150.0, amplitude = 0.5, period = T}'")
+        + " with T = 1/F s for F in " + ", ".join(f"{f:g}" for f in freqs) + " Hz.")
+    lin = beltsim.forced_response(scene, freqs).amplitudes(FLUCTUATION)
+    rows = []
+    for m, f in enumerate(freqs):
+        sine = {"mean": 150.0, "amplitude": FLUCTUATION, "period": 1.0 / f}
+        run = beltsim.run(scene.with_overrides([("pulley.crankshaft.speed", sine)]),
+                          raise_on_failure=False)
+        if not run.converged or not run.periodic:
+            rows.append([f"{f:g}", page.fail(f"arm forced response, {f:g} Hz: "
+                                             f"{run.status.value} ({run.reason})"), "",
+                         *([""] * len(ARM_KEYS))])
+            continue
+        cells = [f"{f:g}", f"{run.wall_time:.3g}", str(run.statistics["steps"])]
+        for key in ARM_KEYS:
+            amp = 0.5 * (run.periodic[key]["max"] - run.periodic[key]["min"])
+            rel = amp / lin[key][m] - 1
+            cell = f"{amp:.4g} / {lin[key][m]:.4g} ({rel:+.2%})"
+            if abs(rel) > FORCED_TOL:
+                cell = page.fail(f"arm forced response, {f:g} Hz, {key}: {rel:+.2%}")
+            cells.append(cell)
+        rows.append(cells)
+    page.table(["frequency [Hz]", "run wall [s]", "steps",
+                *(f"{k}: run / linear" for k in ARM_KEYS)], rows)
+
+    page.para(
+        "The arm in the rotational model's limit (perfect adhesion, no loads, a belt 1e-4 as "
+        "dense, no damping, the arm's neither, `beltdrive.rotational.adhesion_limit`): the "
+        "lowest rotational frequencies of the linearised belt model with the arm free "
+        "against the discrete model with the arm's angle as a degree of freedom "
+        "(`rotational_model`, about the creep theory's rest angle). Command: "
+        f"`beltsim modes {name}` on that scene.")
+    lim = adhesion_limit(shipped_scene(name), elements=100)
+    P = lim.params
+    sol = string_state(P)
+    rest = P.at_arm(sol.arm_travel - P.arm_turn)
+    ref = rotational_model(rest, tension=rest.N0 - rest.rho * sol.c ** 2)
+    found = drive_modes(lim, count=60)
+    light = [m.frequency_hz for m in found.modes if m.damping_ratio < 0.01][:len(ref.names)]
+    page.table(["mode", "belt model [Hz]", "discrete model [Hz]", "relative"],
+               [[str(k + 1), f"{a:.6g}", f"{b:.6g}", f"{a / b - 1:+.2e}"]
+                for k, (a, b) in enumerate(zip(light, ref.frequencies))])
+
+
 def build(page: Page, quick: bool) -> None:
     page.heading("Steady ladders")
     ladders(page, quick)
@@ -284,3 +389,5 @@ def build(page: Page, quick: bool) -> None:
     gross_slip(page, quick)
     page.heading("Forced response to the crankshaft's speed fluctuation")
     forced(page, quick)
+    page.heading("The tensioner's arm in motion")
+    arm_motion(page, quick)

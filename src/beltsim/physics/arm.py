@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from numpy.polynomial.chebyshev import chebval
 
 # Mesh.arm_par's entries
 STIFFNESS, PRELOAD, DAMPING, TURN, LO, HI, LENGTH_A, LENGTH_B = range(8)
@@ -99,13 +100,23 @@ def arm_rows(u, g, mesh, p, w, want_jac):
     w.Gr[iw, jb, 0] -= kb
 
 
+def table_values(beta, mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`arm_values` in numpy, for Python callers (the kernels' arrays stay in
+    numba: a compiled function's array returned to Python after a run in the same process
+    can fail in numba's runtime)."""
+    par = mesh.arm_par
+    x = (2.0 * float(beta) - par[LO] - par[HI]) / (par[HI] - par[LO])
+    rows = chebval(x, mesh.arm_coef.T)
+    return rows[0:2], rows[2:4], rows[4:6]
+
+
 def element_stretches(mesh, g, slope: bool = False) -> np.ndarray:
     """Each element's stretch strain e (N) at the globals ``g``, or with ``slope`` its
     derivative in the arm's angle (zeros without an arm)."""
     e = np.zeros(len(mesh.he))
     if mesh.arm_idx.shape[0] == 0:
         return e
-    values = arm_values(float(g[mesh.arm_idx[0]]), mesh)[1 if slope else 0]
+    values = table_values(g[mesh.arm_idx[0]], mesh)[1 if slope else 0]
     ln = mesh.arm_par[[LENGTH_A, LENGTH_B]]
     on = mesh.arm_el >= 0
     e[on] = values[mesh.arm_el[on]] / ln[mesh.arm_el[on]]

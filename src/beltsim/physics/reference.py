@@ -30,9 +30,9 @@ from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
-from numpy.polynomial.chebyshev import chebval
 
 from ..problem.drive import friction_factor, mismatch, value, value_at
+from .arm import table_values
 from .discrete import CENTRAL, Mesh, ModelParams, State, hermite_weights
 from .friction import ADHESION, AUGMENTATION, is_exact, law_numpy
 from .model import POWER_TERMS
@@ -362,10 +362,8 @@ def _arm_stretch(g, mesh: Mesh):
     (:mod:`beltsim.physics.arm`); zeros and None without an arm."""
     if mesh.arm_idx.shape[0] == 0:
         return np.zeros(len(mesh.he)), None
-    lo, hi, la, lb = mesh.arm_par[4:8]
-    x = (2.0 * g[mesh.arm_idx[0]] - lo - hi) / (hi - lo)
-    delta, slope = (np.array([chebval(x, mesh.arm_coef[r + s]) for s in (0, 1)])
-                    for r in (0, 2))
+    la, lb = mesh.arm_par[6:8]
+    delta, slope, _ = table_values(g[mesh.arm_idx[0]], mesh)
     span = mesh.arm_el
     e = np.where(span >= 0, delta[np.maximum(span, 0)] / np.where(span == 1, lb, la), 0.0)
     return e, (delta, slope)

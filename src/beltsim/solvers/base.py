@@ -192,12 +192,11 @@ class LoopDiscretisation(Discretisation):
         state = super().new_state()
         if self.arm is None:
             return state
-        from ..physics.arm import arm_values, stretch
+        from ..physics.arm import element_stretches
 
         P, m = self.params, self.mesh
         state.g[m.arm_idx[0]] = self.arm_rest
-        delta, slope, _ = arm_values(self.arm_rest, m)
-        e = np.array([stretch(j, delta, slope, m)[0] for j in range(len(m.he))])
+        e = element_stretches(m, state.g)
         # uniform strain N_s / b1: u_x = (N_s - N0) / b1 - e, periodic with zero mean
         ux = np.sum(e * m.he) / P.layout.loop_length - e
         u = np.concatenate([[0.0], np.cumsum(ux * m.he)[:-1]])
