@@ -64,6 +64,30 @@ def stretch(j, delta, slope, mesh):
 
 
 @njit(cache=True, no_cpython_wrapper=True)
+def span_tensions(u, delta, slope, mesh, p):
+    """(T_a, T_b, de_a, de_b): the axial forces of span a's last element and span b's
+    first, and those elements' stretch slopes in the angle."""
+    ia, jb = mesh.arm_idx[1], mesh.arm_idx[2]
+    n = u.shape[0]
+    ia1 = ia + 1 if ia + 1 < n else 0
+    jb1 = jb + 1 if jb + 1 < n else 0
+    ea, dea = stretch(ia, delta, slope, mesh)
+    eb, deb = stretch(jb, delta, slope, mesh)
+    return (p.N0 + p.b1 * ((u[ia1] - u[ia]) / mesh.he[ia] + ea),
+            p.N0 + p.b1 * ((u[jb1] - u[jb]) / mesh.he[jb] + eb), dea, deb)
+
+
+@njit(cache=True, inline="always")
+def arm_torque(beta, omega, ta, tb, slope, mesh):
+    """The torque on the arm but its inertia's: the spring's tau0 - k_t (turn + beta),
+    the damper's -d omega and the belt's -(ta delta_a' + tb delta_b') (ta, tb: the two
+    spans' tensions less rho c^2)."""
+    par = mesh.arm_par
+    return (par[PRELOAD] - par[STIFFNESS] * (par[TURN] + beta) - par[DAMPING] * omega
+            - ta * slope[0] - tb * slope[1])
+
+
+@njit(cache=True, no_cpython_wrapper=True)
 def arm_rows(u, g, mesh, p, w, want_jac):
     """Add the arm's two global rows (their rates excepted: assemble's, through
     ``mesh.inertia``) and their slopes."""
@@ -78,13 +102,9 @@ def arm_rows(u, g, mesh, p, w, want_jac):
     delta, slope, curv = arm_values(beta, mesh)
     ia1 = ia + 1 if ia + 1 < n else 0
     jb1 = jb + 1 if jb + 1 < n else 0
-    ea, dea = stretch(ia, delta, slope, mesh)
-    eb, deb = stretch(jb, delta, slope, mesh)
-    Ta = p.N0 + p.b1 * ((u[ia1] - u[ia]) / he[ia] + ea)
-    Tb = p.N0 + p.b1 * ((u[jb1] - u[jb]) / he[jb] + eb)
+    Ta, Tb, dea, deb = span_tensions(u, delta, slope, mesh, p)
     w.Rg[ib] -= omega
-    w.Rg[iw] += (par[DAMPING] * omega - par[PRELOAD] + par[STIFFNESS] * (par[TURN] + beta)
-                 + (Ta - rc) * slope[0] + (Tb - rc) * slope[1])
+    w.Rg[iw] -= arm_torque(beta, omega, Ta - rc, Tb - rc, slope, mesh)
     if not want_jac:
         return
     w.Gd[ib, iw] -= 1.0

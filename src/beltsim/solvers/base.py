@@ -157,10 +157,6 @@ class LoopDiscretisation(Discretisation):
             raise SceneError("tensioner.inertia", "must be > 0 in a transient (the arm's "
                              "moment of inertia about its pivot, kg m^2, its pulley's mass "
                              "included)")
-        if self.numerics.integrator == "explicit":
-            raise SceneError("tensioner", 'a tensioner\'s arm moves in the implicit schemes '
-                             '("esdirk3", "implicit", "pseudo") and the steady solve; '
-                             '"explicit" does not step it yet')
         table = arm_table(P)
         rest, _ = rest_angle(P, table)
         if abs(rest) > 0.5 * TRAVEL:  # the table reaches round the rest angle too

@@ -3,7 +3,7 @@
 :mod:`beltsim.solvers.explicit` describes the step: the velocity terms (gyroscopic and
 damping) by the trapezoidal rule with the drift, then the kick with friction implicit in
 each friction node's own velocity, swept in the direction of the flow. On a loop
-(``mesh.off`` = 0, :class:`beltsim.physics.discrete.Mesh`) three things differ.
+(``mesh.off`` = 0, :class:`beltsim.physics.discrete.Mesh`) four things differ.
 
 * Periodic sweeps. The velocity system (2/dt + d + G) vm = (2/dt) v_a is lower
   bidiagonal with one entry across the closure: cyclic. Its solution is one pass from
@@ -28,6 +28,10 @@ each friction node's own velocity, swept in the direction of the flow. On a loop
   this kick's Delta c so weakly that taking the last kick's is stable. The round-off of
   the gauge sum hbar u is removed at the next drift, so it stays at one step's.
 
+* A tensioner's arm (:mod:`beltsim.physics.arm`): its angle drifts with its rate as u
+  does, its spans' stretch enters the kick's fluxes, and its rate takes the kick of its
+  torque (the damper's at the rate before the kick: its rate d / J is far below 1 / dt).
+
 * Free pulleys (globals 1..): J omega_t = -M(t) - R sum of its arc's F_j. Their speeds
   enter the slip velocities of their arcs as the nodes' velocities do (omega_b + A_EST
   Delta omega - C_EST Delta omega_last), and the arc's friction is solved together with
@@ -49,6 +53,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..physics.arm import arm_torque, arm_values, span_tensions, stretch
 from ..physics.discrete import hermite_weights, load_at
 from ..physics.friction import ADHESION, EXACT, LINEAR, RAMP, SQRT, TANH
 from ..physics.model import wrap
@@ -258,12 +263,20 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co, arc
     B = p.b1 - rho * ce * ce
     A = p.a - rot * ce * ce
     lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
+    arm = mesh.arm_idx.shape[0] > 0
+    if arm:  # a tensioner's arm: its spans' stretch at its angle (physics.arm)
+        adelta, aslope, _ = arm_values(gb[mesh.arm_idx[0]], mesh)
+    else:
+        adelta = aslope = np.zeros(2)
     gauge = 0.0
     for j in range(n):
         jm = wrap(j - 1, n)
         jp = wrap(j + 1, n)
         ih, il = co[j, C_IH], co[jm, C_IH]
         eu = co[j, C_KM] * B * ((u[jp] - u[j]) * ih - (u[j] - u[jm]) * il)
+        if arm and (mesh.arm_el[j] >= 0 or mesh.arm_el[jm] >= 0):
+            eu += co[j, C_KM] * B * (stretch(j, adelta, aslope, mesh)[0]
+                                     - stretch(jm, adelta, aslope, mesh)[0])
         et = co[j, C_KI] * (A * ((th[jp] - th[j]) * ih - (th[j] - th[jm]) * il)
                             - p.shear * hb[j] * th[j])
         if lk >= 0:
@@ -310,6 +323,13 @@ def _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co, arc
             gtot[K] = tot
             dg[K] = dt * (-load - R * tot) / J
         _commit(j0, count, trial, va, wa, db, sv, fnode, lam, co, p, mesh.face)
+    if arm:  # the arm's kick, its damper explicit (its rate far below 1 / dt)
+        ib = mesh.arm_idx[0]
+        ta, tb, _, _ = span_tensions(u, adelta, aslope, mesh, p)
+        rc = rho * ce * ce
+        dg[ib] = 0.0
+        dg[ib + 1] = dt * arm_torque(gb[ib], gb[ib + 1], ta - rc, tb - rc, aslope,
+                                     mesh) / mesh.inertia[ib + 1]
     # the gauge: the uniform correction to sum hbar v = 0 is c's increment
     total = 0.0
     for j in range(n):
@@ -371,6 +391,8 @@ def advance_loop(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, drive, l
         dc = _loop_drift(u, th, va, wa, vb, wb, pq, co, ga[0], dt, gh[3 * ng], mesh, p)
         gb[:] = ga
         gb[0] += dc
+        if mesh.arm_idx.shape[0] > 0:  # the arm's angle drifts with its rate, as u
+            gb[mesh.arm_idx[0]] += dt * ga[mesh.arm_idx[0] + 1]
         t += dt
         steps += 1
         gh[3 * ng] = _loop_kick(u, th, va, wa, vb, wb, bb, eb, db, sv, fnode, lam, trial, co,
@@ -385,4 +407,6 @@ def advance_loop(state, hist, fresh, t, t_stop, dt, max_steps, mesh, p, drive, l
         for k in range(ng):
             g[k] = gb[k] + 0.5 * dg[k]
             gd[k] = dg[k] / dt
+        if mesh.arm_idx.shape[0] > 0:  # the arm's angle is a position: its rate, the rate
+            gd[mesh.arm_idx[0]] = g[mesh.arm_idx[0] + 1]
     return t, steps
