@@ -78,7 +78,9 @@ class Mesh(NamedTuple):
     seg_radius: np.ndarray = np.zeros(0)  # pulley radius (m)
     seg_speed: np.ndarray = np.zeros(0, dtype=np.int64)  # global of the rim speed, or -1
     loop_length: float = 0.0  # closed: the loop's length Lambda (m)
-    inertia: np.ndarray = np.zeros(0)  # closed: J of each global (0 for c), kg m^2
+    #: closed: the factor of each global's rate in its row: 0 for c, J (kg m^2) for a
+    #: pulley's speed, 1 for a tensioner arm's angle and its J for its rate
+    inertia: np.ndarray = np.zeros(0)
     #: the face in contact at each node: +1 the bottom fibre (lever +h/2), -1 the top
     #: (a back-side idler's arc); a span's nodes take the next arc's, whose stencil they
     #: enter
