@@ -121,7 +121,7 @@ class DriveModes:
         By increasing frequency.
     least_stable : complex
         The eigenvalue with the largest real part among all the finite ones (real ones
-        included, and those beyond the listed band).
+        included, and those beyond the listed band); Im >= 0 of a conjugate pair.
     elements : int
         The grid's elements.
     eigenvalues : int
@@ -249,6 +249,8 @@ def drive_modes(scene, count: int | None = None, f_max: float | None = None,
     else:
         lam, Z = eigenpairs(disc, state)
         least, found = complex(lam[np.argmax(lam.real)]), len(lam)
+    # of a conjugate pair, the one in the upper half plane (as the listed modes)
+    least = least.conjugate() if least.imag < 0.0 else least
     order = _listed(lam, count, f_max)
     modes = tuple(_mode(disc, lam[k], Z[:, k], samples) for k in order)
     return DriveModes(modes, least, N, found, method)
