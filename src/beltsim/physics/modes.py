@@ -26,6 +26,11 @@ How the largest real part is found (:func:`growth_rate`):
   never towards "unstable" on a grid where no unstable mode exists: an unstable
   eigenvalue it reports is one of the fine grid's.
 
+A closed drive's modes (:mod:`beltsim.physics.loop_modes`) use the same pencil, and on
+all but tiny grids its sparse tools: :class:`ShiftInvert` (ARPACK about one shift, one
+sparse LU of the n by n quadratic) and :func:`rightmost` (a sweep of shifts up the
+imaginary axis for the least stable eigenvalue).
+
 See docs/theory/stability.md.
 """
 
