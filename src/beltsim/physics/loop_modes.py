@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import SceneError, UsageError
 from .modes import (
+    INFINITE,
     SWEEP_REACH,
     ShiftInvert,
     eigenpairs,
@@ -294,6 +295,11 @@ def _sparse(disc, state, count, f_max):
         keep = lam.imag < below
         least, found = rightmost(M, C, K, SWEEP_REACH * highest_frequency(disc),
                                  start=(lam, radius))
+        # as the dense path: beyond INFINITE times the grid's highest frequency an
+        # eigenvalue is an infinite one's round-off (ARPACK's Ritz values near 0)
+        finite = np.abs(found) < INFINITE * highest_frequency(disc)
+        least = complex(found[finite][np.argmax(found[finite].real)])
+        found = found[finite]
     return lam[keep], V[:n, keep], least, len(found)
 
 
