@@ -371,7 +371,7 @@ def arm_motion(page: Page, quick: bool) -> None:
     sol = string_state(P)
     rest = P.at_arm(sol.arm_travel - P.arm_turn)
     ref = rotational_model(rest, tension=rest.N0 - rest.rho * sol.c ** 2)
-    found = drive_modes(lim, count=60)
+    found = drive_modes(lim, count=60, method="dense")  # the limit's spread spectrum
     light = [m.frequency_hz for m in found.modes if m.damping_ratio < 0.01][:len(ref.names)]
     page.table(["mode", "belt model [Hz]", "discrete model [Hz]", "relative"],
                [[str(k + 1), f"{a:.6g}", f"{b:.6g}", f"{a / b - 1:+.2e}"]

@@ -33,14 +33,30 @@ import numpy as np
 
 from ..errors import SceneError, UsageError
 from .arm import element_stretches
-from .modes import eigenpairs, steady_discretisation
+from .modes import (
+    INFINITE,
+    SWEEP_REACH,
+    ShiftInvert,
+    eigenpairs,
+    linearisation,
+    one_blas_thread,
+    rightmost,
+    steady_discretisation,
+)
 
-#: The grid when the scene sets none: the dense QZ algorithm's cost grows as the cube of
-#: the grid (`beltsim modes serpentine_accessory`: 6 s end to end on 200 elements, 33 s on
-#: 400)
+#: The grid when the scene sets none
 DEFAULT_ELEMENTS = 200
-#: Beyond this the dense eigensolver takes minutes and gigabytes
-MAX_ELEMENTS = 800
+#: The finest grid ``beltsim modes`` accepts (the sparse search's cost grows about as the
+#: square of the grid)
+MAX_ELEMENTS = 3200
+#: Up to this many elements the spectrum is computed whole by the dense QZ algorithm
+#: (``method="auto"``); its cost grows as the cube of the grid (6 s on 200 elements)
+DENSE_ELEMENTS = 40
+#: The dense method refuses grids beyond this (minutes and gigabytes)
+MAX_DENSE_ELEMENTS = 800
+#: Eigenvalues about 0 the sparse search asks for first (doubled until the listed modes
+#: are complete)
+FIRST_NEAREST = 48
 #: Modes listed when neither a count nor a frequency bound is given
 DEFAULT_COUNT = 10
 #: Samples of the belt's displacement along the loop in a mode's shape
@@ -107,17 +123,22 @@ class DriveModes:
         By increasing frequency.
     least_stable : complex
         The eigenvalue with the largest real part among all the finite ones (real ones
-        included, and those beyond the listed band).
+        included, and those beyond the listed band); Im >= 0 of a conjugate pair.
     elements : int
         The grid's elements.
     eigenvalues : int
-        How many finite eigenvalues the linearisation has.
+        How many eigenvalues were computed: the dense method's every finite one; the
+        sparse method's those its shifts found (a few counted twice where the disks
+        overlap).
+    method : str
+        "dense" or "sparse" (:func:`drive_modes`).
     """
 
     modes: tuple[Mode, ...]
     least_stable: complex
     elements: int
     eigenvalues: int
+    method: str = "dense"
 
     def to_list(self) -> list[dict]:
         """What ``beltsim modes`` writes to modes.json."""
@@ -147,7 +168,9 @@ class DriveModes:
                          f"{m.damping_ratio:>9.2e}  {m.pulley_share:>7.3f}  {m.largest}")
         lam = self.least_stable
         verdict = "grows" if lam.real > 0.0 else "decays"
-        lines.append(f"least stable eigenvalue of {self.eigenvalues} ({self.elements} "
+        of = (f"of {self.eigenvalues}" if self.method == "dense" else
+              f"({self.method}, {self.eigenvalues} found)")
+        lines.append(f"least stable eigenvalue {of} ({self.elements} "
                      f"elements): {lam.real:+.4g} 1/s at {abs(lam.imag) / (2 * math.pi):.4g} "
                      f"Hz ({verdict})")
         return "\n".join(lines)
@@ -161,13 +184,22 @@ def check_options(count, f_max, elements) -> None:
         raise UsageError(f"--f-max: must be > 0 Hz, got {f_max!r}")
     if elements is not None and not (isinstance(elements, int)
                                      and 8 <= elements <= MAX_ELEMENTS):
-        raise UsageError(f"--elements: must be an integer in [8, {MAX_ELEMENTS}] (a dense "
-                         f"eigensolver), got {elements!r}")
+        raise UsageError(f"--elements: must be an integer in [8, {MAX_ELEMENTS}], got "
+                         f"{elements!r}")
 
 
 def drive_modes(scene, count: int | None = None, f_max: float | None = None,
-                elements: int | None = None, samples: int = SAMPLES) -> DriveModes:
+                elements: int | None = None, samples: int = SAMPLES,
+                method: str = "auto") -> DriveModes:
     """The lowest modes of a closed drive's discrete model about its steady state.
+
+    Two methods give the same modes and least stable eigenvalue (the tests compare them):
+    "dense", every eigenvalue by the QZ algorithm (small grids), and "sparse", ARPACK in
+    shift-invert mode: about 0 for the listed modes, the nearest eigenvalues asked for
+    doubling until the listing is complete (a mode missing from the disk of radius r
+    about 0 has abs(lambda) > r, so every listed mode with Im lambda below
+    r sqrt(1 - MAX_DAMPING_RATIO^2) has been found), then a sweep up the imaginary axis
+    for the least stable eigenvalue (:func:`beltsim.physics.modes.rightmost`).
 
     Parameters
     ----------
@@ -182,6 +214,8 @@ def drive_modes(scene, count: int | None = None, f_max: float | None = None,
         The grid; default the scene's ``numerics.elements``, else DEFAULT_ELEMENTS.
     samples : int, optional
         Samples of the belt's displacement in each shape.
+    method : {"auto", "dense", "sparse"}, optional
+        "auto": dense up to DENSE_ELEMENTS elements, sparse above.
 
     Returns
     -------
@@ -204,15 +238,70 @@ def drive_modes(scene, count: int | None = None, f_max: float | None = None,
         elements = min(scene.numerics.get("elements", DEFAULT_ELEMENTS), MAX_ELEMENTS)
     if count is None and f_max is None:
         count = DEFAULT_COUNT
+    if method not in ("auto", "dense", "sparse"):
+        raise UsageError(f"method: 'auto', 'dense' or 'sparse', got {method!r}")
     disc, state = steady_discretisation(scene, elements)
-    lam, Z = eigenpairs(disc, state)
-    least = complex(lam[np.argmax(lam.real)])
-    keep = (lam.imag > 0.0) & (-lam.real < MAX_DAMPING_RATIO * np.abs(lam))
+    N = disc.grid.n_elements
+    if method == "auto":
+        method = "dense" if N <= DENSE_ELEMENTS else "sparse"
+    if method == "dense" and N > MAX_DENSE_ELEMENTS:
+        raise UsageError(f"elements: the dense method stops at {MAX_DENSE_ELEMENTS}, got {N}")
+    if method == "sparse":
+        lam, Z, least, found = _sparse(disc, state, count, f_max)
+    else:
+        lam, Z = eigenpairs(disc, state)
+        least, found = complex(lam[np.argmax(lam.real)]), len(lam)
+    # of a conjugate pair, the one in the upper half plane (as the listed modes)
+    least = least.conjugate() if least.imag < 0.0 else least
+    order = _listed(lam, count, f_max)
+    modes = tuple(_mode(disc, lam[k], Z[:, k], samples) for k in order)
+    return DriveModes(modes, least, N, found, method)
+
+
+def _listed(lam, count, f_max, below=math.inf):
+    """Indices of the listed modes among ``lam``, by increasing frequency: oscillating,
+    damping ratio below MAX_DAMPING_RATIO, Im lambda up to 2 pi f_max and below
+    ``below``, the lowest ``count``."""
+    keep = (lam.imag > 0.0) & (-lam.real < MAX_DAMPING_RATIO * np.abs(lam)) & (lam.imag < below)
     if f_max is not None:
         keep &= lam.imag <= 2.0 * math.pi * f_max
-    order = np.flatnonzero(keep)[np.argsort(lam.imag[keep], kind="stable")][:count]
-    found = tuple(_mode(disc, lam[k], Z[:, k], samples) for k in order)
-    return DriveModes(found, least, disc.grid.n_elements, len(lam))
+    return np.flatnonzero(keep)[np.argsort(lam.imag[keep], kind="stable")][:count]
+
+
+def _sparse(disc, state, count, f_max):
+    """(eigenvalues, their modes z as columns, the least stable eigenvalue, how many
+    eigenvalues were found) by shift-invert; see :func:`drive_modes`."""
+    from ..solvers.linearise import highest_frequency
+
+    M, C, K = linearisation(disc, state)
+    size = 2 * K.shape[0]
+    cone = math.sqrt(1.0 - MAX_DAMPING_RATIO ** 2)
+    k = FIRST_NEAREST
+    with one_blas_thread():
+        near = ShiftInvert(M, C, K, 0.0)
+        while True:
+            k = min(k, size - 2)
+            lam, V = near.nearest(k, vectors=True)
+            radius = float(np.max(np.abs(lam)))
+            below = cone * radius  # every listed mode under this frequency is in lam
+            order = _listed(lam, count, f_max, below)
+            if ((count is not None and len(order) == count)
+                    or (f_max is not None and 2.0 * math.pi * f_max < below)):
+                break
+            if k == size - 2:  # every eigenvalue ARPACK can give: the dense path's job
+                lam, Z = eigenpairs(disc, state)
+                return lam, Z, complex(lam[np.argmax(lam.real)]), len(lam)
+            k *= 2
+        n = K.shape[0]
+        keep = lam.imag < below
+        least, found = rightmost(M, C, K, SWEEP_REACH * highest_frequency(disc),
+                                 start=(lam, radius))
+        # as the dense path: beyond INFINITE times the grid's highest frequency an
+        # eigenvalue is an infinite one's round-off (ARPACK's Ritz values near 0)
+        finite = np.abs(found) < INFINITE * highest_frequency(disc)
+        least = complex(found[finite][np.argmax(found[finite].real)])
+        found = found[finite]
+    return lam[keep], V[:n, keep], least, len(found)
 
 
 def _mode(disc, lam, z, samples) -> Mode:

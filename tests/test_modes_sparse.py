@@ -1,0 +1,73 @@
+"""The sparse modes search (physics.loop_modes: shift-invert about 0, then a sweep up the
+imaginary axis) against the dense QZ algorithm on small grids of several layouts: the
+same listed modes, shapes and least stable eigenvalue."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from beltsim import load_scene
+from beltsim.physics.loop_modes import drive_modes
+from helpers import BACK_IDLER, SERPENTINE_BACK, serpentine_scene
+
+#: Agreement bound on each eigenvalue, relative to its modulus. The dense QZ's backward
+#: error is round-off of the pencil's largest entries (the stuck nodes' penalty, 1e10
+#: times the masses' scale), so its eigenvalues carry an absolute error near
+#: 1e-16 * 1e10 ~ 1e-6 of the spectrum's scale; ARPACK's are solved to 1e-10 of
+#: 1 / (lambda - sigma). Measured on these scenes (60 and 120 elements, 2026-12-03): at
+#: most MEASURED (the accessory drive's 10th mode on 60 elements; the least stable
+#: eigenvalues 3.5e-7 at most); the bound leaves a factor of ten. The shapes (scaled so
+#: their largest displacement is 1): 5e-5 at most, bound SHAPE.
+MEASURED = 2.6e-6
+BOUND = 10 * MEASURED
+SHAPE = 5e-4
+
+SCENES = {
+    "drive_flat": lambda: load_scene("drive_flat"),
+    "accessory": lambda: load_scene("serpentine_accessory"),
+    "accessory_tanh": lambda: load_scene("serpentine_accessory",
+                                         {"numerics.friction_law": "tanh"}),
+    "back_idler": lambda: serpentine_scene(BACK_IDLER),
+    "four_pulleys_back": lambda: serpentine_scene(SERPENTINE_BACK),
+}
+
+
+def _both(name, elements, **kw):
+    scene = SCENES[name]()
+    return (drive_modes(scene, elements=elements, method="dense", **kw),
+            drive_modes(scene, elements=elements, method="sparse", **kw))
+
+
+def _close(a, b):
+    return abs(a - b) <= BOUND * max(abs(a), abs(b))
+
+
+@pytest.mark.verification
+@pytest.mark.parametrize(("name", "elements"), [(name, 60) for name in SCENES
+                                                if name != "accessory_tanh"]
+                         + [(name, 120) for name in SCENES])
+def test_the_sparse_search_finds_the_dense_modes_and_least_stable(name, elements):
+    """The ten lowest listed modes (eigenvalue and shape) and the least stable eigenvalue
+    of every finite one: sparse as dense within BOUND of the eigenvalue's modulus; the
+    shapes (scaled to a real largest displacement 1) within SHAPE."""
+    dense, sparse = _both(name, elements)
+    assert dense.method == "dense" and sparse.method == "sparse"
+    assert len(sparse.modes) == len(dense.modes) == 10
+    for d, s in zip(dense.modes, sparse.modes):
+        assert _close(d.eigenvalue, s.eigenvalue), (d.eigenvalue, s.eigenvalue)
+        assert d.largest == s.largest
+        np.testing.assert_allclose(s.u, d.u, atol=SHAPE)
+        rot = np.array([[d.pulleys[p][0], s.pulleys[p][0]] for p in d.pulleys])
+        np.testing.assert_allclose(rot[:, 1], rot[:, 0], atol=SHAPE * np.max(np.abs(rot)))
+    assert _close(dense.least_stable, sparse.least_stable), (dense.least_stable,
+                                                             sparse.least_stable)
+
+
+@pytest.mark.verification
+def test_the_sparse_search_lists_every_mode_below_a_frequency_bound():
+    """With f_max and no count: the same modes up to 3 kHz (the listing's disk about 0
+    grows until it holds them all)."""
+    dense, sparse = _both("accessory", 60, f_max=3000.0)
+    assert len(dense.modes) >= 5 and len(sparse.modes) == len(dense.modes)
+    np.testing.assert_allclose(sparse.frequencies, dense.frequencies, rtol=BOUND)
