@@ -148,6 +148,15 @@ def test_a_tensioners_arm_turns_as_in_the_spring_model_with_its_arm():
     f = np.array([m.frequency_hz for m in got])
     np.testing.assert_allclose(f, ref.frequencies, rtol=1e-2)
     assert np.max(np.abs(f / ref.frequencies - 1.0)) < 5e-4  # the measurement, with margin
+    # the shapes, the arm's turn among them (cosine > 0.999, as the pulleys' alone above)
+    _, X = ref.solve()
+    sides = {p.name: p.side for p in P.pulleys}
+    for k, mode in enumerate(got):
+        shape = np.array([mode.pulleys[nm][0].real * sides[nm] for nm in ref.names[:-1]]
+                         + [mode.arm.real])
+        cos = abs(shape @ X[:, k]) / (np.linalg.norm(shape) * np.linalg.norm(X[:, k]))
+        assert cos > 0.999, (k, cos)
+    assert "arm" in got[0].to_dict()["shape"]
 
 
 @pytest.mark.verification

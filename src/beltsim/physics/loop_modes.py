@@ -16,10 +16,12 @@ frozen on the stuck arcs), with rates down to -1e10 1/s. All of them count for
   <beltsim.beltdrive.pulleys.PulleyLayout.spin>` tells that sense in the plane;
 * the belt's axial displacement u along the loop coordinate (from the entry of the first
   pulley's arc, in the belt's direction), sampled at equal steps;
+* a tensioner arm's turn beta (rad, into the belt; :mod:`beltsim.physics.arm`);
 
-scaled so that the largest of abs(u) and the pulleys' rim displacements abs(r theta) is
-1 and real positive. ``pulley_share`` is the pulleys' part of the mode's kinetic energy,
-sum J abs(speed)^2 over that plus the belt's sum rho hbar_j abs(lambda u_j)^2 (the
+scaled so that the largest of abs(u), the pulleys' rim displacements abs(r theta) and
+the arm's pulley centre's abs(a beta) is 1 and real positive. ``pulley_share`` is the
+pulleys' and the arm's part of the mode's kinetic energy, sum J abs(speed)^2 over that
+plus the belt's sum rho hbar_j abs(lambda u_j)^2 (the
 Eulerian rate of u: the belt's transport of its perturbation is left out of this
 measure).
 """
@@ -79,8 +81,11 @@ class Mode:
     x: np.ndarray
     u: np.ndarray
     pulley_share: float
-    #: what moves most: a pulley's name (its rim) or "belt"
+    #: what moves most: a pulley's name (its rim), "belt" or "arm" (a tensioner arm's
+    #: pulley centre)
     largest: str
+    #: a tensioner arm's turn (rad, into the belt), None without a moving arm
+    arm: complex | None = None
 
     @property
     def frequency_hz(self) -> float:
@@ -110,7 +115,8 @@ class Mode:
                             for name, (th, w) in self.pulleys.items()},
                 "belt_speed": pair(self.belt_speed),
                 "belt": {"x": self.x.tolist(), "u_real": self.u.real.tolist(),
-                         "u_imag": self.u.imag.tolist()}}}
+                         "u_imag": self.u.imag.tolist()},
+                **({} if self.arm is None else {"arm": pair(self.arm)})}}
 
 
 @dataclass(frozen=True)
@@ -314,19 +320,25 @@ def _mode(disc, lam, z, samples) -> Mode:
     radii = np.array([p.radius for p in P.pulleys])
     xs = np.linspace(0.0, grid.loop_length, samples, endpoint=False)
     us = np.interp(xs, grid.x, u, period=grid.loop_length)
-    # the largest displacement, of the belt or a rim, is 1 and real
-    cand = np.concatenate([us, radii * theta])
+    # a moving tensioner arm's turn, and its pulley centre's displacement a beta
+    arm = None if disc.arm is None else z[2 * N + disc.mesh.arm_idx[0]]
+    centre = [] if arm is None else [P.tensioner.arm(P.layout)[0] * arm]
+    # the largest displacement, of the belt, a rim or the arm's pulley, is 1 and real
+    cand = np.concatenate([us, radii * theta, centre])
     top = int(np.argmax(np.abs(cand)))
     # a mode of the string's rotary unknowns alone moves neither belt nor rims: unscaled
     scale = cand[top] if cand[top] != 0.0 else 1.0
     inertia = np.array([p.inertia for p in P.pulleys])
     pulley_ke = float(np.sum(inertia * np.abs(speeds) ** 2))
+    if arm is not None:
+        pulley_ke += P.tensioner.inertia * float(np.abs(lam * arm) ** 2)
     belt_ke = float(P.rho * np.sum(disc.mesh.hb * np.abs(lam * u) ** 2))
     share = pulley_ke / (pulley_ke + belt_ke) if pulley_ke + belt_ke > 0 else 0.0
+    names = ["belt"] * samples + [p.name for p in P.pulleys] + ["arm"] * len(centre)
     return Mode(complex(lam), {p.name: (complex(t / scale), complex(w / scale))
                                for p, t, w in zip(P.pulleys, theta, speeds)},
-                complex(z[2 * N] / scale), xs, us / scale, share,
-                "belt" if top < samples else P.pulleys[top - samples].name)
+                complex(z[2 * N] / scale), xs, us / scale, share, names[top],
+                None if arm is None else complex(arm / scale))
 
 
 __all__ = ["DEFAULT_COUNT", "DEFAULT_ELEMENTS", "DriveModes", "MAX_DAMPING_RATIO",
