@@ -11,6 +11,8 @@ from ..io.files import prepare_outdir
 
 #: the snapshots of a run (``beltsim run --snapshots``), for ``beltsim animate --from``
 SNAPSHOTS = "snapshots.npz"
+#: The most frames an animation of a run draws (its snapshots evenly thinned to these)
+MAX_FRAMES = 150
 
 
 def format_drive(summary: dict, title: str = "") -> str:
@@ -153,6 +155,11 @@ def animate_drive_run(run_dir, path, fps: int = 15):
     P = DriveScene.load(run_dir / "scene.toml").params
     with np.load(run_dir / SNAPSHOTS) as z:
         data = {k: z[k] for k in z.files}
+    # at most MAX_FRAMES, evenly over the run, the last among them
+    n = len(data["t"])
+    keep = np.unique(np.linspace(0, n - 1, min(n, MAX_FRAMES)).round().astype(int))
+    data = {k: v[keep] if np.ndim(v) and len(v) == n and k != "x" else v
+            for k, v in data.items()}
     if "grid_arm_travel" in data:  # the grid is laid with the arm turned
         P = P.at_arm(float(data["grid_arm_travel"]))
     return animate_drive(P, data["x"], snapshot_frames(P, data), times=data["t"],
