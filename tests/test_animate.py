@@ -85,3 +85,14 @@ def test_animating_leaves_the_users_matplotlib_as_it_was(tmp_path):
     assert path.read_bytes()[4:8] == b"ftyp"
     assert (matplotlib.get_backend(), plt.get_fignums(),
             matplotlib.rcParams["animation.ffmpeg_path"]) == before
+
+
+@pytest.mark.unit
+def test_mp4_is_the_default_where_ffmpeg_is_at_hand_else_a_gif_said_so(monkeypatch):
+    from beltsim.plots import frames
+
+    monkeypatch.setattr(frames, "ffmpeg_available", lambda: True)
+    assert frames.default_format() == ("mp4", None)
+    monkeypatch.setattr(frames, "ffmpeg_available", lambda: False)
+    fmt, note = frames.default_format()
+    assert fmt == "gif" and "ffmpeg" in note and "\n" not in note

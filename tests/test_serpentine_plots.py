@@ -258,3 +258,130 @@ def test_a_tensioner_run_is_drawn_with_its_arm_at_rest(tmp_path):
                                atol=1e-15)
     assert [p.name for p in plot_drive_run(tmp_path)] == ["drive.png", "fields.png",
                                                          "history.png"]
+
+
+# ---------------------------------------------------------------------------
+# a tensioner's arm moving in a transient
+
+
+@pytest.fixture(scope="module")
+def arm_run(tmp_path_factory):
+    """A short start-up of serpentine_tensioner whose arm moves (esdirk3), coarse, stored
+    with its snapshots (about 3 s)."""
+    out = tmp_path_factory.mktemp("arm_run")
+    scene = beltsim.load_scene("serpentine_tensioner", {
+        "numerics.integrator": "esdirk3", "numerics.elements": 200, "numerics.t_end": 0.1})
+    result = beltsim.run(scene, snapshot_interval=0.02)
+    save_run(result, out)
+    return out
+
+
+def _spy_frames(monkeypatch):
+    """Record, frame by frame as the animation draws them, the drawing's tensioner
+    circle, the arm's bar and the title (no file written)."""
+    from beltsim.beltdrive import animation
+
+    made, seen = [], []
+    real = drawing.DriveDrawing.__init__
+
+    def spy(self, *args, **kwargs):
+        made.append(self)
+        real(self, *args, **kwargs)
+
+    def record(path, frames_rgb, fps):
+        d = made[-1]
+        for _ in frames_rgb:
+            seen.append({"centres": np.array([p[0].center for p in d.pulleys]),
+                         "bar": None if d.arm is None else d.arm[2].get_xydata().copy(),
+                         "title": d.belt.axes.get_title(),
+                         "belt": np.concatenate([s for s in d.belt.get_segments()])})
+        return path
+
+    monkeypatch.setattr(drawing.DriveDrawing, "__init__", spy)
+    monkeypatch.setattr(animation, "write_frames", record)
+    return made, seen
+
+
+def test_a_moving_arm_is_animated_at_each_frames_angle(arm_run, tmp_path, monkeypatch):
+    """Each frame draws the tensioner pulley, its arm and the belt's path where
+    Tensioner.turned puts them at that frame's travel, the drawn arm dashed."""
+    snaps = np.load(arm_run / "snapshots.npz")
+    travel = snaps["arm_travel"]
+    assert travel.shape == snaps["t"].shape and abs(travel[0] - travel[-1]) > 5e-3
+    made, seen = _spy_frames(monkeypatch)
+    animate_drive_run(arm_run, tmp_path / "arm.gif", fps=5)
+    assert len(seen) == len(travel)
+    scene = beltsim.load_scene(arm_run / "scene.toml")
+    drawn = scene.params.layout  # the scene's layout: the arm as drawn
+    ten = scene.params.tensioner
+    k = ten.index
+    for frame, beta in zip(seen, travel):
+        at = ten.turned(drawn, float(beta))
+        np.testing.assert_allclose(frame["centres"][k], at.centres[k], rtol=0, atol=1e-9)
+        np.testing.assert_allclose(frame["bar"], [ten.pivot, at.centres[k]], rtol=0,
+                                   atol=1e-9)
+        # the belt runs round the turned pulley: its path touches the rim
+        gap = np.hypot(*(frame["belt"] - at.centres[k]).T).min() - at.radii[k]
+        assert abs(gap) < 1e-6
+        assert f"arm travel β = {beta:.4g} rad" in frame["title"]
+        others = np.delete(frame["centres"], k, axis=0)
+        np.testing.assert_array_equal(others, np.delete(drawn.centres, k, axis=0))
+    # two frames, two places: the first and the last frame's pulley moved apart
+    assert math.dist(seen[0]["centres"][k], seen[-1]["centres"][k]) > 3e-4
+    dashed = next(a for a in made[-1].belt.axes.lines if a.get_gid() == "arm drawn")
+    np.testing.assert_allclose(dashed.get_xydata()[-1], drawn.centres[k], atol=1e-12)
+
+
+def test_a_fixed_layout_animates_as_before(short_run, tmp_path, monkeypatch):
+    """No tensioner: no arm, every pulley where the layout has it in every frame, and
+    the blitted frames redraw only the belt's state (the pulleys stay in the
+    background)."""
+    made, seen = _spy_frames(monkeypatch)
+    animate_drive_run(short_run, tmp_path / "d.gif", fps=5)
+    layout = made[-1].layout
+    assert made[-1].arm is None and "arm travel" not in seen[-1]["title"]
+    for frame in seen:
+        np.testing.assert_array_equal(frame["centres"], layout.centres)
+        np.testing.assert_array_equal(frame["belt"], seen[0]["belt"])
+    assert not any(isinstance(a, Circle) for a in made[-1].moving())
+    assert "arm_travel" not in np.load(short_run / "snapshots.npz").files
+
+
+def test_carried_keeps_each_segments_fraction():
+    P = beltsim.load_scene("serpentine_tensioner").params
+    g, h = P.layout, P.tensioner.turned(P.layout, 0.05)
+    assert h.loop_length != g.loop_length
+    assert drawing.carried(g, g, g.bounds) is not None
+    np.testing.assert_allclose(drawing.carried(g, h, g.bounds[:-1]), h.bounds[:-1],
+                               atol=1e-14)
+    mid = 0.5 * (g.bounds[3] + g.bounds[4])
+    np.testing.assert_allclose(drawing.carried(g, h, [mid, mid + g.loop_length]),
+                               [0.5 * (h.bounds[3] + h.bounds[4]),
+                                0.5 * (h.bounds[3] + h.bounds[4]) + h.loop_length])
+
+
+def test_a_transient_runs_plot_draws_its_end_state_arm_and_its_history(arm_run, tmp_path):
+    """The run's grid is laid at the rest angle (summary grid_arm_travel), its end state
+    has the arm elsewhere (arm_travel): drive.png draws the nodes on the grid's layout
+    carried over to the end state's, the arm at arm_travel; history.png has the arm."""
+    from beltsim.beltdrive.io import read_drive_run
+
+    scene, x, f, hist, summary = read_drive_run(arm_run)
+    assert summary["grid_arm_travel"] != summary["arm_travel"]
+    assert "arm_travel" in hist
+    paths = plot_drive_run(arm_run, tmp_path)
+    assert [p.name for p in paths] == ["drive.png", "fields.png", "history.png"]
+    P = scene.params
+    k = P.tensioner.index
+    end = P.at_arm(summary["arm_travel"])
+    with offscreen():
+        fig = draw_drive(P.at_arm(summary["grid_arm_travel"]), x, f["tension"],
+                         arm=(P.tensioner.pivot, end.layout.centres[k],
+                              P.layout.centres[k]), at=end)
+        bar = next(a for a in fig.axes[0].lines if a.get_gid() == "arm")
+        np.testing.assert_allclose(bar.get_xydata()[-1], end.layout.centres[k], atol=1e-12)
+        history = plot_drive_history(hist["t"], hist)
+    labels = [ax.get_ylabel() for ax in history.axes]
+    assert any("arm travel" in s for s in labels)
+    ax = next(ax for ax in history.axes if "arm travel" in ax.get_ylabel())
+    np.testing.assert_array_equal(ax.lines[0].get_ydata(), hist["arm_travel"])

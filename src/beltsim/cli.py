@@ -371,9 +371,11 @@ def cmd_animate(args):
     if args.fps < 1:
         raise UsageError(f"--fps: must be >= 1, got {args.fps}")
     if args.format is None:
-        from .plots.animate import ffmpeg_available
+        from .plots.frames import default_format
 
-        args.format = "mp4" if ffmpeg_available() else "gif"
+        args.format, note = default_format()
+        if note:
+            print(note, file=sys.stderr)
     if args.from_dir:
         if args.scene or args.overrides:
             raise UsageError("--from DIR animates a stored run: give no SCENE or --set")

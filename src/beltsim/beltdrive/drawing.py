@@ -1,6 +1,7 @@
 """The drive drawn to scale, on any layout: its pulleys (back-side idlers on the belt's
 outer face), the belt coloured by its tension, the slip arcs, the hub loads and the
-pulleys' names; and that drawing animated over a run's snapshots.
+pulleys' names, a tensioner's arm (animated over a run's snapshots by
+:mod:`beltsim.beltdrive.animation`).
 
 One code path draws every drive from its :class:`~beltsim.beltdrive.pulleys.PulleyLayout`
 (the two-pulley drive is the layout of two inner pulleys:
@@ -15,13 +16,10 @@ from __future__ import annotations
 
 import math
 import textwrap
-from collections.abc import Mapping
-from pathlib import Path
 
 import numpy as np
 
-from ..io.files import atomic_path
-from ..plots.common import offscreen, panel_axes
+from ..plots.common import panel_axes
 from .plot_input import drive_layout, loads, mask, nodes, span_names, vector
 
 #: The belt's colours (tension, N) and the slip arcs' contrasting marking.
@@ -162,6 +160,25 @@ class _Clearance:
         return float(min(to_rims.min(), near.min() - self.belt_width, 3.0 * inside))
 
 
+def carried(base, layout, xs) -> np.ndarray:
+    """Loop coordinates xs on ``base`` carried over to ``layout`` (the same pulleys, one
+    of them moved: a tensioner's arm turned), segment by segment: a point a fraction of
+    the way along an arc or a span of ``base`` goes as far along that of ``layout``. The
+    loop model takes the arm's change of the loop length up as a stretch of the grid on
+    the spans (:mod:`beltsim.physics.arm`); the drawing spreads it over each segment."""
+    xs = np.asarray(xs, dtype=float)
+    if layout is base:
+        return xs
+    lam = base.loop_length
+    turns = np.floor(xs / lam)
+    r = xs - lam * turns
+    k = base.segment_of(r)
+    lengths = np.diff(base.bounds)
+    to = np.diff(layout.bounds)
+    return (layout.bounds[k] + (r - base.bounds[k]) * to[k] / lengths[k]
+            + layout.loop_length * turns)
+
+
 class DriveDrawing:
     """The artists of one drawing of a drive, redrawn in place for each frame.
 
@@ -179,13 +196,22 @@ class DriveDrawing:
         One per pulley (m/s), written under its name.
     hub_max : float, optional
         The hub load (N) drawn HUB_ARROW of the layout's size long; None: no hub loads.
+    hub_loads : ndarray, optional
+        (n, 2) (N): the labels are placed clear of these hub loads' arrows.
+    arm : (int, pivot, drawn), optional
+        A tensioner's arm: its pulley's index, its pivot and where the scene draws the
+        pulley's centre (m): the arm as a bar to the pulley, the drawn one dashed.
+
+    ``x`` lives on ``layout``; :meth:`show` may draw a state on another layout of the same
+    pulleys (the tensioner's arm turned), the nodes :func:`carried` over to it, the
+    labels where they were placed on ``layout``.
     """
 
     def __init__(self, ax, layout, x, norm, *, roles=None, rim_speeds=None, hub_max=None,
-                 hub_loads=None):
+                 hub_loads=None, arm=None):
         from matplotlib.collections import LineCollection
 
-        self.layout, self.x = layout, x
+        self.layout, self.base, self.x = layout, layout, x
         lam = layout.loop_length
         lo, hi, size = extent(layout)
         self.offset = SLIP_OFFSET * size
@@ -207,11 +233,9 @@ class DriveDrawing:
 
         # the belt: fine pieces of its path, each coloured by the tension at its middle
         # (linear between the nodes)
-        xf = np.union1d(x, np.linspace(x[0], x[0] + lam, PATH_SAMPLES + 1))
-        X, Y = layout.path(xf)
-        pts = np.column_stack([X, Y])
-        self.mid = 0.5 * (xf[:-1] + xf[1:])
-        self.belt = LineCollection(np.stack([pts[:-1], pts[1:]], axis=1), cmap=TENSION_CMAP,
+        self.xf = np.union1d(x, np.linspace(x[0], x[0] + lam, PATH_SAMPLES + 1))
+        self.mid = 0.5 * (self.xf[:-1] + self.xf[1:])
+        self.belt = LineCollection(self._belt_pieces(), cmap=TENSION_CMAP,
                                    norm=norm, linewidths=6.0, capstyle="round", zorder=3,
                                    gid="belt")
         self.belt.set_array(np.zeros(len(self.mid)))
@@ -223,9 +247,10 @@ class DriveDrawing:
                       for j, name in enumerate(span_names(layout, roles))
                       if layout.spans[j] >= SHORT_SPAN * size]
         # the pulleys' names last: each where it is clearest of all the rest
-        for i in range(n):
-            self._pulley(ax, i, None if rim_speeds is None else rim_speeds[i])
+        self.pulleys = [self._pulley(ax, i, None if rim_speeds is None else rim_speeds[i])
+                        for i in range(n)]
         self.hubs = [] if self.hub_scale is None else [self._hub(ax, i) for i in range(n)]
+        self.arm = None if arm is None else self._arm(ax, *arm)
 
         ax.set_xlim(self.limits[0][0], self.limits[1][0])
         ax.set_ylim(self.limits[0][1], self.limits[1][1])
@@ -241,20 +266,13 @@ class DriveDrawing:
         g = self.layout
         (cx, cy), r, name = g.centres[i], g.radii[i], g.names[i]
         back = g.sides[i] < 0
-        ax.add_patch(Circle((cx, cy), r, facecolor=BACK_FACE if back else INNER_FACE,
-                            edgecolor="0.35", lw=1.2, zorder=1, gid=f"pulley {name}"))
-        ax.plot([cx], [cy], "+", color="0.25", ms=7, mew=1.0, zorder=2)
-        # a curved arrow inside the pulley in its running sense (a back-side idler turns
-        # against the inner pulleys), over its top either way
-        a1, a2 = math.radians(35.0), math.radians(145.0)
+        disc = ax.add_patch(Circle((cx, cy), r, facecolor=BACK_FACE if back else INNER_FACE,
+                                   edgecolor="0.35", lw=1.2, zorder=1, gid=f"pulley {name}"))
+        (hub,) = ax.plot([cx], [cy], "+", color="0.25", ms=7, mew=1.0, zorder=2)
         spin = int(g.spin[i])
-        if spin < 0:
-            a1, a2 = a2, a1
-        ax.add_patch(FancyArrowPatch(
-            (cx + 0.62 * r * math.cos(a1), cy + 0.62 * r * math.sin(a1)),
-            (cx + 0.62 * r * math.cos(a2), cy + 0.62 * r * math.sin(a2)),
-            connectionstyle=f"arc3,rad={0.5 * spin}", arrowstyle="-|>", mutation_scale=8,
-            color="0.35", lw=1.0, zorder=2, gid="spin"))
+        arrow = ax.add_patch(FancyArrowPatch(
+            *self._spin_ends(i), connectionstyle=f"arc3,rad={0.5 * spin}",
+            arrowstyle="-|>", mutation_scale=8, color="0.35", lw=1.0, zorder=2, gid="spin"))
         text = name + ("\n(back side)" if back else "")
         if rim is not None:
             text += f"\nrim {rim:.4g} m/s"
@@ -272,8 +290,83 @@ class DriveDrawing:
         at, u, box = self._clearest(candidates, lines, PULLEY_FONT)
         self.clear.add(box)
         ha, va = _align(u)
-        ax.text(at[0], at[1], text, fontsize=PULLEY_FONT, fontweight="bold", color="0.2",
-                zorder=6, ha=ha, va=va, gid="pulley name")
+        label = ax.text(at[0], at[1], text, fontsize=PULLEY_FONT, fontweight="bold",
+                        color="0.2", zorder=6, ha=ha, va=va, gid="pulley name")
+        return disc, hub, arrow, label
+
+    def _spin_ends(self, i):
+        """The ends of the curved arrow inside pulley i in its running sense (a back-side
+        idler turns against the inner pulleys), over its top either way."""
+        g = self.layout
+        (cx, cy), r = g.centres[i], g.radii[i]
+        a1, a2 = math.radians(35.0), math.radians(145.0)
+        if g.spin[i] < 0:
+            a1, a2 = a2, a1
+        return ((cx + 0.62 * r * math.cos(a1), cy + 0.62 * r * math.sin(a1)),
+                (cx + 0.62 * r * math.cos(a2), cy + 0.62 * r * math.sin(a2)))
+
+    def _belt_pieces(self) -> np.ndarray:
+        """The belt's fine pieces (pieces, 2, 2) on the layout drawn."""
+        X, Y = self.layout.path(carried(self.base, self.layout, self.xf))
+        pts = np.column_stack([X, Y])
+        return np.stack([pts[:-1], pts[1:]], axis=1)
+
+    def _span_arrow(self, j):
+        """The ends of the arrow beside span j's middle in the belt's direction, and the
+        span's outward normal there."""
+        g = self.layout
+        xm = 0.5 * (g.bounds[2 * j + 1] + g.bounds[2 * j + 2])
+        half = 0.1 * g.spans[j]
+        (xa, xb), (ya, yb) = g.path(np.array([xm - half, xm + half]))
+        nx, ny = outward(g, np.array([xm]))[:, 0]
+        shift = 3.0 * self.offset
+        return ((xa + shift * nx, ya + shift * ny), (xb + shift * nx, yb + shift * ny),
+                (nx, ny))
+
+    def _arm(self, ax, k, pivot, drawn):
+        """A tensioner's arm from its pivot to pulley k's centre, and dashed where the
+        scene draws it (its travel between the two)."""
+        pivot = np.asarray(pivot, dtype=float)
+        ax.plot(*np.column_stack([pivot, drawn]), color="0.55", lw=1.5, ls="--", zorder=5,
+                gid="arm drawn")
+        (bar,) = ax.plot(*np.column_stack([pivot, self.layout.centres[k]]), color="0.25",
+                         lw=4.0, zorder=5, solid_capstyle="round", gid="arm",
+                         label="tensioner arm (drawn: dashed)")
+        ax.plot(*pivot, marker="o", ms=7, mfc="white", mec="0.25", zorder=6)
+        return k, pivot, bar
+
+    def place(self, layout):
+        """Move the drawing onto ``layout``, the same pulleys as the one it was made on
+        with one moved (a tensioner's arm turned): the belt's path, the pulleys, the
+        spans' arrows and the arm (the labels stay where they were placed)."""
+        if layout is self.layout:
+            return
+        self.layout = layout
+        self.belt.set_segments(self._belt_pieces())
+        for i, (disc, hub, arrow, _) in enumerate(self.pulleys):
+            c = layout.centres[i]
+            disc.set_center(tuple(c))
+            hub.set_data([c[0]], [c[1]])
+            arrow.set_positions(*self._spin_ends(i))
+        for _, _, _, arrow, j in self.spans:
+            arrow.set_positions(*self._span_arrow(j)[:2])
+        if self.arm is not None:
+            k, pivot, bar = self.arm
+            bar.set_data(*np.column_stack([pivot, layout.centres[k]]))
+
+    def moving(self, layout=False) -> list:
+        """The artists :meth:`show` changes, in the order they are drawn: with
+        ``layout``, those :meth:`place` moves too (and the pulleys' names, drawn over
+        them)."""
+        out = [self.belt, self.slip, *(a for _, _, label, _, _ in self.spans
+                                        for a in [label])]
+        out += [a for pair in self.hubs for a in pair]
+        if layout:
+            out += [a for p in self.pulleys for a in p]
+            out += [arrow for _, _, _, arrow, _ in self.spans]
+            if self.arm is not None:
+                out.append(self.arm[2])
+        return sorted(out, key=lambda a: a.get_zorder())
 
     def _span(self, ax, j, name):
         """The belt's motion on span j (an arrow beside it) and a label for its mean
@@ -282,15 +375,9 @@ class DriveDrawing:
 
         g = self.layout
         e, k = g.bounds, 2 * j + 1
-        xm = 0.5 * (e[k] + e[k + 1])
-        half = 0.1 * g.spans[j]
-        (xa, xb), (ya, yb) = g.path(np.array([xm - half, xm + half]))
-        nx, ny = outward(g, np.array([xm]))[:, 0]
-        shift = 3.0 * self.offset
-        ax.add_patch(FancyArrowPatch((xa + shift * nx, ya + shift * ny),
-                                     (xb + shift * nx, yb + shift * ny),
-                                     arrowstyle="-|>", mutation_scale=14, lw=1.4,
-                                     color="0.2", zorder=5, gid="motion"))
+        a, b, (nx, ny) = self._span_arrow(j)
+        arrow = ax.add_patch(FancyArrowPatch(a, b, arrowstyle="-|>", mutation_scale=14,
+                                             lw=1.4, color="0.2", zorder=5, gid="motion"))
         lines = [name, "mean 00000 N"] if name else ["00000 N"]
         # outside the loop at the span's middle, or further along it, or inside, where
         # the outside is crowded or cut off
@@ -304,7 +391,7 @@ class DriveDrawing:
         ha, va = _align(u)
         label = ax.text(at[0], at[1], "", ha=ha, va=va, fontsize=SPAN_FONT, zorder=6,
                         gid="span tension")
-        return g.segment_of(self.x) == k, name, label
+        return g.segment_of(self.x) == k, name, label, arrow, j
 
     def _clearest(self, candidates, lines, fontsize):
         """The first of ``candidates`` (anchor, direction) whose text box is clear by
@@ -340,16 +427,20 @@ class DriveDrawing:
         u = F / max(np.hypot(*F), 1e-300)
         return u, c + self.hub_scale * F + 1.5 * self.offset * u
 
-    def show(self, tension, slip, hub_loads=None):
-        """Draw one state: the nodal tension (N), the slip mask (None: no slip drawn) and
-        the hub loads (n, 2) (N; None leaves the arrows as they are)."""
+    def show(self, tension, slip, hub_loads=None, layout=None):
+        """Draw one state: the nodal tension (N), the slip mask (None: no slip drawn),
+        the hub loads (n, 2) (N; None leaves the arrows as they are) and the layout
+        (None: as it is; another, :meth:`place`)."""
+        if layout is not None:
+            self.place(layout)
         g = self.layout
-        lam = g.loop_length
+        lam = self.base.loop_length
         self.belt.set_array(np.interp(self.mid, self.x, tension, period=lam))
         runs = [] if slip is None else slip_runs(self.x, slip, lam)
         px, py = [], []
         for a, b in runs:
-            xs = np.linspace(a, b, max(2, math.ceil((b - a) / self.ds) + 1))
+            xs = carried(self.base, g, np.linspace(a, b, max(2, math.ceil((b - a) / self.ds)
+                                                             + 1)))
             X, Y = g.path(xs)
             # away from the pulley the belt slips on: outwards on an inner pulley, into
             # the loop on a back-side idler
@@ -359,7 +450,7 @@ class DriveDrawing:
             px += [X + self.offset * n[0], [np.nan]]
             py += [Y + self.offset * n[1], [np.nan]]
         self.slip.set_data(np.concatenate(px) if px else [], np.concatenate(py) if py else [])
-        for on, name, label in self.spans:
+        for on, name, label, _, _ in self.spans:
             text = f"{name}\nmean " if name else ""
             if on.any():
                 text += f"{np.mean(tension[on]):.4g} N"
@@ -389,7 +480,7 @@ class DriveDrawing:
 
 
 def draw_drive(layout, x, tension, slip=None, *, ax=None, title=None, rim_speeds=None,
-               tension_range=None, hub_loads=None, roles=None, arm=None):
+               tension_range=None, hub_loads=None, roles=None, arm=None, at=None):
     """The drive to scale, its belt coloured by the tension, the slip arcs marked.
 
     The pulleys are drawn where the layout puts them, each named beside its wrap (the
@@ -426,8 +517,14 @@ def draw_drive(layout, x, tension, slip=None, *, ax=None, title=None, rim_speeds
         The pulleys' roles, to name the tight and the slack span (known already from a
         DriveParams or a Geometry).
     arm : (pivot, centre, drawn), optional
-        A tensioner's arm: its pivot, the pulley's centre in this layout and where the
-        scene draws it (m, (x, y) each): the arm as a bar, the drawn one dashed.
+        A tensioner's arm: its pivot, the pulley's centre in the layout drawn (``at``,
+        else ``layout``) and where the scene draws it (m, (x, y) each): the arm as a
+        bar, the drawn one dashed.
+    at : PulleyLayout or DriveParams, optional
+        The layout to draw the state on where it is not the one ``x`` lives on: the same
+        pulleys with a tensioner's arm turned (a transient's grid is laid with the arm
+        at its rest angle; its state has the arm elsewhere). The nodes are
+        :func:`carried` over to it.
 
     Returns
     -------
@@ -444,6 +541,10 @@ def draw_drive(layout, x, tension, slip=None, *, ax=None, title=None, rim_speeds
     layout, roles = drive_layout(layout, roles)
     n = len(layout)
     x = nodes(layout, x)
+    moved = None if at is None else drive_layout(at, roles)[0]
+    if moved is not None and (len(moved) != n or moved.names != layout.names):
+        raise ValueError("at: must be the same pulleys as the layout, in its order")
+    drawn = moved if moved is not None else layout
     tension = vector("tension", tension, len(x))
     slip = None if slip is None else mask("slip", slip, len(x))
     rims = None if rim_speeds is None else vector("rim_speeds", rim_speeds, n, "pulley")
@@ -458,11 +559,14 @@ def draw_drive(layout, x, tension, slip=None, *, ax=None, title=None, rim_speeds
         norm = Normalize(lo, hi)
     fig, (ax,), _ = panel_axes(ax, 1, figsize=drawing_size(layout))
     hub_max = None if hubs is None else float(np.max(np.hypot(hubs[:, 0], hubs[:, 1])))
-    drawing = DriveDrawing(ax, layout, x, norm, roles=roles, rim_speeds=rims,
-                           hub_max=hub_max, hub_loads=hubs)
-    drawing.show(tension, slip, hubs)
     if arm is not None:
-        _draw_arm(ax, *(np.asarray(q, dtype=float) for q in arm))
+        pivot, centre, where = (np.asarray(q, dtype=float) for q in arm)
+        # the arm's pulley: the one at ``centre``
+        k = int(np.argmin(np.hypot(*(drawn.centres - centre).T)))
+        arm = (k, pivot, where)
+    drawing = DriveDrawing(ax, layout, x, norm, roles=roles, rim_speeds=rims,
+                           hub_max=hub_max, hub_loads=hubs, arm=arm)
+    drawing.show(tension, slip, hubs, layout=moved)
     fig.colorbar(drawing.belt, ax=ax, label="belt tension N [N]", shrink=0.9)
     drawing.legend(ax, slip=slip is not None and bool(slip.any()))
     if title:
@@ -471,113 +575,4 @@ def draw_drive(layout, x, tension, slip=None, *, ax=None, title=None, rim_speeds
     return fig
 
 
-def _draw_arm(ax, pivot, centre, drawn):
-    """A tensioner's arm from its pivot to the pulley's centre, and dashed where the
-    scene draws it (its travel between the two)."""
-    ax.plot(*np.column_stack([pivot, drawn]), color="0.55", lw=1.5, ls="--", zorder=5)
-    ax.plot(*np.column_stack([pivot, centre]), color="0.25", lw=4.0, zorder=5,
-            solid_capstyle="round", gid="arm", label="tensioner arm (drawn: dashed)")
-    ax.plot(*pivot, marker="o", ms=7, mfc="white", mec="0.25", zorder=6)
-
-
-def animate_drive(layout, x, frames, *, times, path, fps=20, dpi=80, roles=None):
-    """Animate :func:`draw_drive` over ``frames`` on one colour scale, to a GIF or an MP4.
-
-    Parameters
-    ----------
-    layout : PulleyLayout, DriveParams or Geometry
-        The drive, as for :func:`draw_drive`.
-    x : array_like
-        The nodes' loop coordinates (m), as for :func:`draw_drive`.
-    frames : sequence of mapping
-        One per frame: ``"tension"`` (nodal, N), optionally ``"slip"`` (nodal booleans),
-        ``"hub_loads"`` ((n, 2), N; on one scale over the frames, given in every frame
-        or in none) and the scalars ``"belt_speed"`` (m/s) and ``"driven_speed"``
-        (rad/s, a two-pulley drive's), written in the frame's title.
-    times : array_like
-        The frames' times (s).
-    path : str or Path
-        The file to write (atomically): ``.gif`` (Pillow) or ``.mp4`` (ffmpeg, from
-        imageio-ffmpeg).
-    fps : int, optional
-        Frames per second.
-    dpi : float, optional
-    roles : sequence of str, optional
-        As for :func:`draw_drive`.
-
-    Returns
-    -------
-    Path
-
-    Raises
-    ------
-    ValueError
-        Another suffix, no frames, or a frame whose arrays do not match ``x`` or the
-        pulleys.
-    """
-    import matplotlib
-    from matplotlib import animation
-
-    path = Path(path)
-    fmt = path.suffix.lower()
-    if fmt not in (".gif", ".mp4"):
-        raise ValueError(f"path: must end in .gif or .mp4, got {path.name!r}")
-    layout, roles = drive_layout(layout, roles)
-    x = nodes(layout, x)
-    frames = list(frames)
-    if not frames:
-        raise ValueError("frames: needs at least one frame")
-    times = vector("times", times, len(frames), "frame")
-    tensions, slips, hubs, titles = [], [], [], []
-    for k, frame in enumerate(frames):
-        if not isinstance(frame, Mapping) or "tension" not in frame:
-            raise ValueError(f"frames[{k}]: must be a mapping with a 'tension' array")
-        tensions.append(vector(f"frames[{k}]['tension']", frame["tension"], len(x)))
-        slip = frame.get("slip")
-        slips.append(None if slip is None else mask(f"frames[{k}]['slip']", slip, len(x)))
-        if (frame.get("hub_loads") is None) != (frames[0].get("hub_loads") is None):
-            raise ValueError(f"frames[{k}]: 'hub_loads' in every frame or in none")
-        hubs.append(None if frame.get("hub_loads") is None else
-                    loads(f"frames[{k}]['hub_loads']", frame["hub_loads"], len(layout)))
-        text = f"t = {times[k]:.4g} s"
-        if frame.get("belt_speed") is not None:
-            text += f"    belt speed c = {float(frame['belt_speed']):.4g} m/s"
-        if frame.get("driven_speed") is not None:
-            text += f"    driven speed ω2 = {float(frame['driven_speed']):.4g} rad/s"
-        titles.append(text)
-    lo = min(float(T.min()) for T in tensions)
-    hi = max(float(T.max()) for T in tensions)
-    hub_max = None if hubs[0] is None else max(
-        float(np.max(np.hypot(F[:, 0], F[:, 1]))) for F in hubs)
-
-    with offscreen():  # a figure for a file: no window, no backend
-        fig, (ax,), _ = panel_axes(None, 1, figsize=drawing_size(layout))
-    # the labels keep clear of the last frame's hub loads (the state the run ends in)
-    drawing = DriveDrawing(ax, layout, x, tension_norm(lo, hi), roles=roles,
-                           hub_max=hub_max, hub_loads=hubs[-1])
-    fig.colorbar(drawing.belt, ax=ax, label="belt tension N [N]", shrink=0.9)
-    drawing.legend(ax)
-    stamp = ax.set_title("", fontsize=10)
-
-    def draw(k):
-        drawing.show(tensions[k], slips[k], hubs[k])
-        stamp.set_text(titles[k])
-
-    with atomic_path(path, suffix=fmt) as tmp:
-        anim = animation.FuncAnimation(fig, draw, frames=len(frames), blit=False)
-        settings = {}
-        if fmt == ".gif":
-            writer = animation.PillowWriter(fps=fps)
-        else:
-            import imageio_ffmpeg
-            # for this save only: the user's rcParams stay as they are
-            settings["animation.ffmpeg_path"] = imageio_ffmpeg.get_ffmpeg_exe()
-            # libx264 takes only even frame sizes: pad an odd one by a pixel
-            writer = animation.FFMpegWriter(fps=fps, codec="libx264", extra_args=[
-                "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p"])
-        with matplotlib.rc_context(settings):
-            anim.save(tmp, writer=writer, dpi=dpi)
-    return path
-
-
-__all__ = ["DriveDrawing", "animate_drive", "draw_drive", "slip_runs"]
+__all__ = ["DriveDrawing", "carried", "draw_drive", "slip_runs"]

@@ -11,6 +11,8 @@ from ..io.files import prepare_outdir
 
 #: the snapshots of a run (``beltsim run --snapshots``), for ``beltsim animate --from``
 SNAPSHOTS = "snapshots.npz"
+#: The most frames an animation of a run draws (its snapshots evenly thinned to these)
+MAX_FRAMES = 150
 
 
 def format_drive(summary: dict, title: str = "") -> str:
@@ -78,22 +80,26 @@ def plot_drive_run(run_dir, out=None) -> list:
 
     scene, x, f, hist, summary = read_drive_run(run_dir)
     out = prepare_outdir(out or run_dir)
-    P, arm = scene.params, None
-    if P.tensioner is not None:  # the run's layout: the tensioner's arm at rest
+    P, grid, arm = scene.params, scene.params, None
+    if P.tensioner is not None:
+        # the state's layout: the arm where the run ends; the grid's (x's), that one
+        # after a steady search, the layout at the rest angle where the arm moved
         k = P.tensioner.index
         drawn = P.layout.centres[k]
-        P = P.at_arm(summary.get("arm_travel") or 0.0)
+        travel = summary.get("arm_travel") or 0.0
+        P = P.at_arm(travel)
+        grid = scene.params.at_arm(summary.get("grid_arm_travel", travel))
         arm = (P.tensioner.pivot, P.layout.centres[k], drawn)
     try:
         ana = exact_state(P)
     except NoSolutionError:  # no steady state (gross slip): the run's own fields only
         ana = None
     hubs = [p["hub_load"] for p in summary["pulleys"]] if "pulleys" in summary else None
-    paths = [save_figure(drawing.draw_drive, out / "drive.png", P, x, f["tension"],
+    paths = [save_figure(drawing.draw_drive, out / "drive.png", grid, x, f["tension"],
                          f["slip"] > 0.5, title=scene.title or Path(run_dir).name,
-                         hub_loads=hubs, arm=arm),
+                         hub_loads=hubs, arm=arm, at=P),
              save_figure(plots.plot_loop_fields, out / "fields.png", x,
-                         {"tension": f["tension"], "friction": f["friction"]}, P,
+                         {"tension": f["tension"], "friction": f["friction"]}, grid,
                          analytic=ana)]
     if hist:
         # the steady values only where the run reached them: a periodic drive's or a
@@ -105,22 +111,29 @@ def plot_drive_run(run_dir, out=None) -> list:
 
 
 def snapshot_frames(P, data) -> list[dict]:
-    """The frames of :func:`~beltsim.beltdrive.drawing.animate_drive` from a run's
-    snapshots (snapshots.npz read as a mapping): each one's tension, slip, belt speed,
-    hub loads (from the tension at each span's middle, as the run's summary has them
-    from its span tensions) and, on two pulleys, the driven pulley's speed."""
+    """The frames of :func:`~beltsim.beltdrive.animation.animate_drive` from a run's
+    snapshots (snapshots.npz read as a mapping; ``P`` the DriveParams of its grid's
+    layout): each one's tension, slip, belt speed, hub loads (from the tension at each
+    span's middle, as the run's summary has them from its span tensions, on the layout
+    of the frame), a moving tensioner's arm travel and, on two pulleys, the driven
+    pulley's speed."""
     from .figures import hub_loads
 
     g = P.layout
     x = data["x"]
     middles = 0.5 * (g.bounds[1:-1:2] + g.bounds[2::2])
+    travels = data["arm_travel"] if "arm_travel" in data else None
     frames = []
     for i in range(len(data["t"])):
         T = data["tension"][i]
         c = float(data["belt_speed"][i])
         spans = np.interp(middles, x, T, period=g.loop_length)
-        frame = {"tension": T, "slip": data["slip"][i], "belt_speed": c,
-                 "hub_loads": hub_loads(g, P.rho, c, spans)}
+        frame = {"tension": T, "slip": data["slip"][i], "belt_speed": c}
+        gi = g
+        if travels is not None:
+            frame["arm_travel"] = float(travels[i])
+            gi = P.tensioner.turned(g, float(travels[i]) - P.arm_turn)
+        frame["hub_loads"] = hub_loads(gi, P.rho, c, spans)
         if P.two_pulley:
             frame["driven_speed"] = float(data["driven_speed"][i])
         frames.append(frame)
@@ -129,17 +142,25 @@ def snapshot_frames(P, data) -> list[dict]:
 
 def animate_drive_run(run_dir, path, fps: int = 15):
     """Animate the snapshots of a stored drive run, on any layout, into ``path`` (.gif
-    or .mp4)."""
+    or .mp4); a tensioner's arm at each snapshot's angle where it moves."""
     from pathlib import Path
 
     from ..errors import UsageError
-    from . import drawing
+    from .animation import animate_drive
     from .scene import DriveScene
 
     run_dir = Path(run_dir)
     if not (run_dir / SNAPSHOTS).is_file():
         raise UsageError(f"{run_dir}: no {SNAPSHOTS} there (run with --snapshots INTERVAL)")
     P = DriveScene.load(run_dir / "scene.toml").params
-    data = np.load(run_dir / SNAPSHOTS)
-    return drawing.animate_drive(P, data["x"], snapshot_frames(P, data), times=data["t"],
-                                 path=path, fps=fps)
+    with np.load(run_dir / SNAPSHOTS) as z:
+        data = {k: z[k] for k in z.files}
+    # at most MAX_FRAMES, evenly over the run, the last among them
+    n = len(data["t"])
+    keep = np.unique(np.linspace(0, n - 1, min(n, MAX_FRAMES)).round().astype(int))
+    data = {k: v[keep] if np.ndim(v) and len(v) == n and k != "x" else v
+            for k, v in data.items()}
+    if "grid_arm_travel" in data:  # the grid is laid with the arm turned
+        P = P.at_arm(float(data["grid_arm_travel"]))
+    return animate_drive(P, data["x"], snapshot_frames(P, data), times=data["t"],
+                         path=path, fps=fps)

@@ -26,7 +26,8 @@ import numpy as np
 
 from ..plots.common import panel_axes
 from ..plots.run import EXACT_STYLE, RUN_STYLE
-from .drawing import animate_drive, draw_drive
+from .animation import animate_drive
+from .drawing import draw_drive
 from .plot_input import drive_layout, nodes, span_names, vector
 
 #: Points the analytic curves are sampled at.
@@ -44,14 +45,17 @@ HISTORY_PANELS = ((("belt_speed",), None, "belt speed c [m/s]"),
                   (("driven_speed",), "speed", "pulley speed ω [rad/s]"),
                   (("speed_ratio",), None, "speed ratio ω2R2 / ω1R1 [-]"),
                   (("tight_tension", "slack_tension"), "tension", "span tension [N]"),
-                  (("driver_torque", "load_torque"), "torque", "torque [N m]"))
+                  (("driver_torque", "load_torque"), "torque", "torque [N m]"),
+                  (("arm_travel",), None, "tensioner arm travel β [rad]"))
 HISTORY_LINES = {"belt_speed": ("belt speed", "tab:red"),
                  "driven_speed": ("driven pulley", "tab:red"),
                  "speed_ratio": ("speed ratio", "tab:red"),
                  "tight_tension": ("tight span", "tab:red"),
                  "slack_tension": ("slack span", "tab:blue"),
                  "driver_torque": ("driver torque M1", "tab:red"),
-                 "load_torque": ("load torque M2", "tab:blue")}
+                 "load_torque": ("load torque M2", "tab:blue"),
+                 "arm_travel": ("arm travel (into the belt, from the drawn angle)",
+                                "tab:green")}
 #: A panel of more lines than this has its legend beside it, not over the lines.
 LEGEND_INSIDE = 3
 
@@ -200,8 +204,8 @@ def _history_panels(history):
 
 def plot_drive_history(t, history, *, ax=None, steady=None):
     """The drive's quantities over time, one panel for each group the history holds:
-    the belt speed, the pulleys' speeds, the speed ratio, the span tensions and the
-    torques.
+    the belt speed, the pulleys' speeds, the speed ratio, the span tensions, the
+    torques and a tensioner's arm travel.
 
     Parameters
     ----------
@@ -213,8 +217,8 @@ def plot_drive_history(t, history, *, ax=None, steady=None):
         ``load_torque``, or a drive's on N pulleys
         (:func:`~beltsim.beltdrive.figures.figure_keys`): ``speed[A]`` of every pulley,
         ``tension[A-B]`` of every span and ``torque[A]``, which take the place of the
-        two-pulley keys of their panel. Those present are drawn; other keys are left
-        out.
+        two-pulley keys of their panel; and a tensioner's ``arm_travel`` (rad). Those
+        present are drawn; other keys are left out.
     ax : Axes or sequence of Axes, optional
         One per panel; default a new figure.
     steady : mapping of str to float, optional

@@ -59,11 +59,15 @@ def write_snapshots(path, result) -> Path:
     Arrays: ``x`` (nodes), ``t`` (times) and the layout's fields, each (times, nodes)
     (``result.solution.snapshot_arrays``): ``u``, ``theta``, ``friction`` (the traction in
     N/m at the friction nodes, as in fields.csv) and, for a drive, ``tension``, ``slip``
-    and the speeds ``belt_speed``, ``driven_speed`` (times); ``scene`` (the scene as TOML
-    text). Single precision keeps a long run's file small and is far finer than a plot.
+    and the speeds ``belt_speed``, ``driven_speed`` (times), with a moving tensioner's arm
+    ``arm_travel`` (times) and ``grid_arm_travel`` (the grid's layout's, double
+    precision); ``scene`` (the scene as TOML text). Single precision keeps a long run's
+    file small and is far finer than a plot.
     """
     sol, snaps = result.solution, result.snapshots
-    arrays = {k: np.asarray(v).astype(np.float32) if np.asarray(v).dtype.kind == "f" else v
+    # the fields in single precision; a scalar (the grid's arm turn) as it is
+    arrays = {k: np.asarray(v).astype(np.float32)
+              if np.asarray(v).dtype.kind == "f" and np.ndim(v) else v
               for k, v in sol.snapshot_arrays(snaps).items()}
     buf = io.BytesIO()
     np.savez_compressed(buf, x=sol.x, t=snaps["t"], **arrays,

@@ -14,13 +14,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.files import OutputError, atomic_path
+from ..io.files import OutputError
 from ..io.results import read_snapshots
 from ..problem import analytic
 from ..problem.drive import drive_of, friction_factor, has_profiles, mismatch
 from ..simulation.solution import stress_resultants
 from ..solvers.settings import resolve
 from .common import offscreen, panel_axes
+from .frames import blit_frames, ffmpeg_available, write_frames
+
+__all__ = ["animate", "ffmpeg_available", "frame_fields", "scheme_label"]
 
 MAX_FRAMES = 150
 # (key, axis label) of the panels, top to bottom
@@ -176,81 +179,5 @@ def animate(snapshots_path, out_path, fmt: str = "gif", fps: int = 15) -> Path:
         stamp.set_text(f"t = {1e3 * times[k]:.2f} ms{drive_text(times[k])}   {how}")
         return [*lines.values(), marks, stamp]
 
-    out_path = Path(out_path)
-    frames_rgb = _frames(fig, draw, frames, moving=[*lines.values(), marks, stamp])
-    with atomic_path(out_path, suffix=f".{fmt}") as tmp:
-        (_write_gif if fmt == "gif" else _write_mp4)(tmp, frames_rgb, fps)
-    return out_path
-
-
-#: Pixels per inch of the animation's frames
-DPI = 80
-#: A GIF's colours: one palette for every frame, so that what does not move stays the
-#: same and each frame stores only what changed
-GIF_COLOURS = 64
-
-
-def _frames(fig, draw, frames, moving):
-    """The frames as RGB arrays: the figure drawn once without the ``moving`` artists,
-    and on that background only they, frame by frame (the axes, ticks and labels, most
-    of a full redraw's time, do not change)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.text import Text
-
-    draw(frames[0])  # the first frame's time stamp is in the layout
-    fig.set_dpi(DPI)
-    canvas = FigureCanvasAgg(fig)
-    fig.draw_without_rendering()
-    fig.set_layout_engine("none")  # laid out once: the frames must not move the axes
-    # the background without them: a text emptied (a hidden title would be placed off
-    # the figure), the rest hidden
-    texts = [a for a in moving if isinstance(a, Text)]
-    for artist in moving:
-        artist.set_text("") if artist in texts else artist.set_visible(False)
-    canvas.draw()
-    background = canvas.copy_from_bbox(fig.bbox)
-    for artist in moving:
-        artist.set_visible(True)
-    for k in frames:
-        draw(k)
-        canvas.restore_region(background)
-        for artist in moving:
-            fig.draw_artist(artist)
-        yield np.asarray(canvas.buffer_rgba())[..., :3].copy()
-
-
-def _write_gif(path, frames_rgb, fps):
-    from PIL import Image
-
-    first, *rest = (Image.fromarray(rgb) for rgb in frames_rgb)
-    palette = first.quantize(colors=GIF_COLOURS, method=Image.Quantize.MEDIANCUT)
-    rest = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in rest]
-    palette.save(path, format="GIF", save_all=True, append_images=rest, loop=0,
-                 duration=round(1000 / fps))
-
-
-def _write_mp4(path, frames_rgb, fps):
-    import imageio_ffmpeg
-
-    first = next(frames_rgb)
-    height, width = first.shape[:2]
-    writer = imageio_ffmpeg.write_frames(path, (width, height), fps=fps, codec="libx264",
-                                         pix_fmt_out="yuv420p", macro_block_size=2,
-                                         output_params=["-f", "mp4"])
-    writer.send(None)  # start ffmpeg
-    try:
-        for rgb in (first, *frames_rgb):
-            writer.send(np.ascontiguousarray(rgb))
-    finally:
-        writer.close()
-
-
-def ffmpeg_available() -> bool:
-    """Whether an ffmpeg binary is at hand (imageio-ffmpeg's, or one it finds)."""
-    try:
-        import imageio_ffmpeg
-
-        imageio_ffmpeg.get_ffmpeg_exe()
-    except (ImportError, RuntimeError):
-        return False
-    return True
+    return write_frames(out_path, blit_frames(fig, draw, frames,
+                                              moving=[*lines.values(), marks, stamp]), fps)

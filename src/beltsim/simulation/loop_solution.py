@@ -250,7 +250,9 @@ class LoopSolution:
         {from, to, tension}), ``pulleys`` (a list of {name, role, speed, slip_arc, wrap,
         torque, hub_load [Fx, Fy]}), each span's and pulley's figures under
         :func:`~beltsim.beltdrive.figures.figure_keys`' names, the power terms, a
-        tensioner's ``arm_angle`` and ``arm_travel``, a two-pulley drive's SUMMARY_KEYS
+        tensioner's ``arm_angle`` and ``arm_travel`` (and where its arm moves
+        ``grid_arm_travel``, the travel of the layout x is laid on), a two-pulley drive's
+        SUMMARY_KEYS
         and, with ``path``, the driver's speed and the load of this time."""
         P = self.params
         T = self.span_tensions()
@@ -266,6 +268,8 @@ class LoopSolution:
                **layout_summary(P.layout, P.roles, P.rho, self.c, T, speeds, arcs,
                                 torques),
                **self.arm_figures()}
+        if self.mesh.arm_idx.shape[0]:  # the arm moves: the turn of the grid's layout
+            out["grid_arm_travel"] = P.arm_turn
         if P.two_pulley:
             ratio = self.omega2 * P.geometry.R2 / self.rim1 if self.rim1 > 0 else math.nan
             out.update({"tight_tension": float(T[1]), "slack_tension": float(T[0]),
@@ -278,8 +282,10 @@ class LoopSolution:
 
     def snapshot_arrays(self, snaps: dict) -> dict:
         """What snapshots.npz holds of a run's snapshots: u, theta, the traction, the
-        axial force and the sliding nodes (times, nodes), and the belt's and the driven
-        pulley's speeds (times)."""
+        axial force and the sliding nodes (times, nodes), the belt's and the driven
+        pulley's speeds and the globals (times) and, where a tensioner's arm moves, its
+        ``arm_travel`` (times; rad from the drawn angle) and ``grid_arm_travel`` (the
+        turn of the layout the grid is laid on)."""
         from ..physics.discrete import State
 
         out = {k: [] for k in ("u", "theta", "friction", "tension", "slip", "belt_speed",
@@ -295,7 +301,12 @@ class LoopSolution:
             out["belt_speed"].append(st.g[0])
             out["driven_speed"].append(st.g[1])
             out["globals"].append(st.g)
-        return {k: np.array(v) for k, v in out.items()}
+        out = {k: np.array(v) for k, v in out.items()}
+        if self.mesh.arm_idx.shape[0]:
+            # the arm's travel from its drawn angle, and the grid's (the layout of x)
+            out["arm_travel"] = self.params.arm_turn + out["globals"][:, self.mesh.arm_idx[0]]
+            out["grid_arm_travel"] = np.array(self.params.arm_turn)
+        return out
 
     # outcomes ---------------------------------------------------------
     def lift_off(self) -> str | None:
