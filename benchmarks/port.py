@@ -50,7 +50,7 @@ from beltsim.solvers.implicit import (
     SAFETY,
     ImplicitScheme,
 )
-from beltsim.solvers.newton import CONTRACTION, LAW_GAP, NEAR_BOUND, ROUNDOFF_FLOOR
+from beltsim.solvers.newton import CONTRACTION, NEAR_BOUND, ROUNDOFF_FLOOR, SLIP_GAP
 
 from .peers import FixedPattern, coo_parts
 
@@ -189,19 +189,22 @@ class PortScheme(Scheme):
         return float(np.abs(dl).max()) if dl.size else 0.0
 
     def release_stuck_ratios(self, lam, lam0, asm):
-        """Vectorised :func:`beltsim.solvers.newton.release_stuck_ratios`."""
+        """Vectorised :func:`beltsim.solvers.newton.release_stuck_ratios`: the largest
+        change."""
         jc, code = self.jc, self.disc.model.law
         lj = lam[jc]
         cand = (asm.sg < NEAR_BOUND) & (lj * asm.rl < 0.0)
         if not cand.any():
-            return False
+            return 0.0
         s = asm.rl[cand] + law_inverse_numpy(code, lam0[cand])[0]
-        off = np.abs(law_numpy(code, s)[0] - lj[cand]) > LAW_GAP
+        off = np.abs(law_inverse_numpy(code, lj[cand])[0] - s) > SLIP_GAP
         if not off.any():
-            return False
+            return 0.0
         idx = jc[cand][off]
-        lam[idx] = 0.0
-        return True
+        new = np.clip(law_numpy(code, s[off])[0], -LAM_MAX, LAM_MAX)
+        big = float(np.abs(new - lam[idx]).max())
+        lam[idx] = new
+        return big
 
     def newton(self, state, old, inv_dt, t):
         """Vectorised :func:`beltsim.solvers.newton.newton` (primal-dual branch)."""
@@ -227,11 +230,10 @@ class PortScheme(Scheme):
             dlam = self.update_multipliers(lam, dx, inv_dt, asm)
             u[1:-1] += dx[:, 0]
             th[1:-1] += dx[:, 1]
-            update = max(step, dlam)
+            update = max(step, dlam, self.release_stuck_ratios(lam, lam0, asm))
             rate = update / previous if it > 0 and previous > 0.0 else 1.0
-            if ((update < tol or (update < ROUNDOFF_FLOOR * tol and update > 0.5 * previous)
-                    or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol))
-                    and not self.release_stuck_ratios(lam, lam0, asm)):
+            if (update < tol or (update < ROUNDOFF_FLOOR * tol and update > 0.5 * previous)
+                    or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol)):
                 d = self.disc
                 vrel = np.zeros(self.jc.size)  # the forces of the ratios alone
                 fnode[:] = reference.friction(vrel, t, d.mesh, d.model, d.drive, lam)[0]
