@@ -108,11 +108,14 @@ def border_row_dot(bd, r, y):
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def schur(bd):
     """bd.Sinv from bd.X = A^{-1} Bm; False when the complement is singular."""
-    nb = bd.Dm.shape[0]
+    nb, ni, b = bd.X.shape
     S = bd.Dm.copy()
-    for r in range(nb):
+    for r in range(2 * b):  # the border nodes' rows: three band rows each
         for q in range(nb):
             S[r, q] -= border_row_dot(bd, r, bd.X[q])
+    if nb > 2 * b:  # the globals' rows, dense: one matrix product (BLAS)
+        S[2 * b:, :] -= np.dot(bd.Cm[2 * b:].reshape(nb - 2 * b, ni * b),
+                               bd.X.reshape(nb, ni * b).T)
     # scale rows and columns to unit diagonal-ish size: the border mixes metres, N and 1/s
     d = np.ones(nb)
     for r in range(nb):
@@ -147,8 +150,11 @@ def finish(bd, r, rg, x, dg):
         bd.rb[b + a] = r[n - 1, a]
     for k in range(nb - 2 * b):
         bd.rb[2 * b + k] = rg[k]
-    for q in range(nb):
+    for q in range(2 * b):
         bd.rb[q] -= border_row_dot(bd, q, x)
+    if nb > 2 * b:  # the globals' rows, dense (BLAS)
+        bd.rb[2 * b:] -= np.dot(bd.Cm[2 * b:].reshape(nb - 2 * b, ni * b),
+                                x[:ni].reshape(ni * b))
     z = bd.Sinv @ bd.rb
     for q in range(nb):
         for i in range(ni):
