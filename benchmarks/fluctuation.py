@@ -17,7 +17,6 @@ the timing.
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 
@@ -128,6 +127,8 @@ def main(argv=None) -> int:
     from beltsim.api import load_scene
     from beltsim.problem.tomlio import parse_toml
 
+    from .drive import emit
+
     p = argparse.ArgumentParser(prog="python -m benchmarks.fluctuation")
     p.add_argument("scene", nargs="?", default="serpentine_accessory")
     p.add_argument("--laws", default=",".join(LAWS))
@@ -144,11 +145,7 @@ def main(argv=None) -> int:
         sets.append((key, parse_toml(f"v = {text}")["v"]))
     out = bench(load_scene(args.scene), tuple(x for x in args.laws.split(",") if x),
                 args.seconds, args.amplitude, args.frequency, sets)
-    text = json.dumps(out)
-    if args.json:
-        with open(args.json, "w", encoding="utf-8") as fh:
-            fh.write(text)
-    print(text)
+    emit(out, args.json)
     return 0
 
 
