@@ -49,10 +49,12 @@ ROUNDOFF_MERIT = 1e-26
 # most halvings of such a step
 CYCLE_ITERATIONS = 8
 MAX_HALVINGS = 8
-# A friction ratio with slope dlam/ds below NEAR_BOUND (|lam| > 0.995 for tanh) whose
-# inverse g^-1(lam) differs from its slip velocity (over v_reg) by more than SLIP_GAP
-# towards the inside is stuck at the bound
+# A friction ratio with slope dlam/ds below NEAR_BOUND (|lam| > 0.995 for tanh) that
+# differs from the law at its slip velocity by more than LAW_GAP is stuck at the bound;
+# while Newton's updates grow, one whose g^-1(lam) lies beyond that slip velocity (over
+# v_reg) by more than SLIP_GAP
 NEAR_BOUND = 1e-2
+LAW_GAP = 1e-3
 SLIP_GAP = 0.1
 
 #: Counters a scheme accumulates, one record the kernels update in place.
@@ -313,31 +315,36 @@ def friction_forces(lam, fnode, u, g, t, mesh, p, drive):
 
 
 @njit(cache=True, no_cpython_wrapper=True)
-def release_stuck_ratios(lam, w, mesh, code):
-    """Move the friction ratios stuck near +-1 against their slip velocity onto the law;
-    returns the largest change (0: none).
+def release_stuck_ratios(lam, w, mesh, code, growing):
+    """Restart the friction ratios stuck near +-1 against their slip velocity; returns
+    the largest change (0: none).
 
     Near the bound the dual update sg (rl + ...) is tiny (slope sg = 1 - lam^2 for tanh)
     even when the slip velocity has turned: a node leaving the slip at a stick
     transition stays at lam = -1 with v_rel / v_reg = +50, and the updates pass every
-    convergence test; a node the fraction-to-the-boundary rule of the update has taken
-    towards the bound (99% of the way an iteration) comes back only by a factor
-    1 + 2 abs(rl) of its update per iteration, some ten iterations. Such a ratio (sg
-    below NEAR_BOUND, its g^-1(lam) beyond s = v_rel / v_reg of the iterate before the
-    update by more than SLIP_GAP) is set to the law's value g(s) (within LAM_MAX), where
-    the primal-dual iteration goes on from a consistent pair. Called at every
-    iteration; its change counts in the update's size (Newton does not stop on a
-    release).
+    convergence test. At convergence, such a ratio (sg below NEAR_BOUND, off
+    g(v_rel / v_reg) of the iterate before the update by more than LAW_GAP) is not
+    converged: it restarts from 0, where the slope is largest (from the bound the update
+    grows only by a factor 1 + 2 abs(rl) per iteration), and Newton goes on. While the
+    updates grow (``growing``: a ratio the fraction-to-the-boundary rule took near the
+    bound coming back, some ten iterations), a ratio whose g^-1(lam) lies beyond that
+    slip velocity by more than SLIP_GAP is set to the law's value there instead.
     """
     big = 0.0
     for j in mesh.cn:
         if w.sg[j] < NEAR_BOUND and lam[j] * w.rl[j] < 0.0:
             s = w.rl[j] + law_inverse(code, w.lam0[j])[0]
-            if abs(law_inverse(code, lam[j])[0] - s) > SLIP_GAP:
-                g = law(code, s)[0]
+            g = law(code, s)[0]
+            if growing:
+                if abs(law_inverse(code, lam[j])[0] - s) <= SLIP_GAP:
+                    continue
                 g = min(LAM_MAX, max(-LAM_MAX, g))
-                big = max(big, abs(g - lam[j]))
-                lam[j] = g
+            elif abs(g - lam[j]) > LAW_GAP:
+                g = 0.0
+            else:
+                continue
+            big = max(big, abs(g - lam[j]))
+            lam[j] = g
     return big
 
 
@@ -410,8 +417,17 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
             if not np.isfinite(dlam):  # a ratio started on the bound, where g^-1 is not
                 st.merit = merit(R, Rg, scales)
                 return False
-            update = max(step, dlam, release_stuck_ratios(lam, w, mesh, p.law))
-            if update_converged(update, previous, it, tol):
+            update = max(step, dlam)
+            converged = update_converged(update, previous, it, tol)
+            # a stuck ratio: sought at convergence, and wherever the updates grow (a
+            # ratio near the bound coming back slowly); sought at every iteration, its
+            # moves cycled with the updates that take it to the bound
+            if converged or update > previous:
+                moved = release_stuck_ratios(lam, w, mesh, p.law, not converged)
+                if moved > 0.0:
+                    update = max(update, moved)
+                    converged = False
+            if converged:
                 friction_forces(lam, fnode, u, g, t, mesh, p, drive)
                 return True
             assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)
