@@ -382,12 +382,17 @@ def main(argv=None) -> int:
     out = bench(load_scene(args.scene), args.repeat, args.elements, grids,
                 kernels=not args.no_kernels,
                 peer_cap=args.peer_cap if args.peers is not None else None, which=which)
-    text = json.dumps(out)
-    if args.json:
-        with open(args.json, "w", encoding="utf-8") as fh:
+    emit(out, args.json)
+    return 0
+
+
+def emit(out: dict, path=None) -> None:
+    """Print ``out`` as one line of JSON, last; with ``path``, write it there too."""
+    text = json.dumps(_plain(out))
+    if path:
+        with open(path, "w", encoding="utf-8") as fh:
             fh.write(text)
     print(text)
-    return 0
 
 
 if __name__ == "__main__":

@@ -63,6 +63,8 @@ from beltsim.physics.discrete import State
 from beltsim.physics.friction import ADHESION, EXACT, TANH, is_exact
 from beltsim.problem.drive import value
 
+from .peers import step_to_steady
+
 #: a steady peer's span tensions and globals within this of our steady state (relative)
 SAME_STEADY = 1e-8
 #: the start-up's: our own run stops ~1e-8 to 1e-7 from the steady state (steady_tol 1e-7)
@@ -342,6 +344,19 @@ def _newton(prob, x, old, inv_dt, t, drive, tol, max_iterations, deadline, stats
                      f"residual {math.sqrt(merit):.3g})"
 
 
+def _steady_start(d, cap, tol):
+    """What a steady peer starts from: the clock and its deadline ``cap`` s on, the
+    tolerance (default our Newton's), the creep theory's state, the steady drive and an
+    old state (unused at inv_dt = 0)."""
+    from beltsim.solvers.steady import creep_state
+
+    start = time.perf_counter()
+    tol = d.numerics.newton_tol if tol is None else tol
+    st = d.new_state()
+    creep_state(d, st)
+    return start, start + cap, tol, st, d.steady_drive(), d.new_state()
+
+
 def run_newton_peer(d, twin: bool = False, cap: float = 300.0, tol: float | None = None,
                     max_iterations: int = 100) -> PeerResult:
     """Newton on the steady residual, sparse differenced Jacobian, spsolve, from the
@@ -349,17 +364,10 @@ def run_newton_peer(d, twin: bool = False, cap: float = 300.0, tol: float | None
     its state (our steady scheme's stages)."""
     from beltsim.beltdrive.analytic import creep_speed
     from beltsim.solvers.settings import LOOP_REGULARISATION
-    from beltsim.solvers.steady import creep_state
 
     name = ("Newton, reference residual, sparse FD Jacobian (grouped), spsolve"
             + (", tanh twin first" if twin else ""))
-    start = time.perf_counter()
-    deadline = start + cap
-    tol = d.numerics.newton_tol if tol is None else tol
-    st = d.new_state()
-    creep_state(d, st)
-    drive = d.steady_drive()
-    old = d.new_state()
+    start, deadline, tol, st, drive, old = _steady_start(d, cap, tol)
     stats: dict = {}
     model = d.model
     x = None
@@ -399,18 +407,11 @@ def run_root_peer(d, method: str = "krylov", cap: float = 300.0,
     or "hybr" (MINPACK, its own dense forward differences)."""
     from scipy.optimize import root
 
-    from beltsim.solvers.steady import creep_state
 
     name = {"krylov": "scipy.optimize.root krylov (Newton-LGMRES, Jacobian-free)",
             "hybr": "scipy.optimize.root hybr (MINPACK, dense FD Jacobian)",
             "lm": "scipy.optimize.root lm (MINPACK, dense FD Jacobian)"}[method]
-    start = time.perf_counter()
-    deadline = start + cap
-    tol = d.numerics.newton_tol if tol is None else tol
-    st = d.new_state()
-    creep_state(d, st)
-    drive = d.steady_drive()
-    old = d.new_state()
+    start, deadline, tol, st, drive, old = _steady_start(d, cap, tol)
     prob = LoopProblem(d)
     xs, rs = prob.scale(), prob.row_scale()
 
@@ -689,27 +690,13 @@ def run_ode_peer(sim, method: str = "Radau", rtol: float = 1e-3,
     solver = {"Radau": Radau, "BDF": BDF}[method](
         ode.rhs, 0.0, np.zeros(ode.size), num.t_end, rtol=rtol, atol=rtol * ode.scale())
     steady, check = sim.steady, sim.check
-    k, converged, reason, steps, y, t = 1, False, "not steady by t_end", 0, None, 0.0
-    while solver.status == "running":
-        if time.perf_counter() - start > cap:
-            reason = f"stopped at the {cap:g} s cap at t = {solver.t:.4g} s"
-            break
-        solver.step()
-        steps += 1
-        if solver.status == "failed":
-            reason = f"solver failed at t = {solver.t:.4g} s"
-            break
-        if solver.t >= k * check:
-            dense = solver.dense_output()
-            while k * check <= solver.t and not converged:
-                t = k * check
-                y = dense(t)
-                st = ode.state(t, y)
-                converged = steady.update(t, sim.readout.rate(st), sim.readout.monitor(st))
-                k += 1
-            if converged:
-                reason = "steady"
-                break
+
+    def measure(t, y):
+        st = ode.state(t, y)
+        return sim.readout.rate(st), sim.readout.monitor(st)
+
+    converged, reason, steps, t, y = step_to_steady(solver, steady, check, cap, start,
+                                                    measure)
     wall = time.perf_counter() - start
     if not converged and reason.startswith("not steady"):
         # at rtol 1e-3 the end state is close, but its rates (the light pulleys'

@@ -213,6 +213,35 @@ def _state_scale(sim: Simulation, n: int) -> np.ndarray:
     return np.concatenate([np.tile([sc.u, sc.theta], n), np.tile([vel, vel / P.L], n)])
 
 
+def step_to_steady(solver, steady, check, cap, start, measure):
+    """Step a scipy ``OdeSolver`` (Radau, BDF) by hand, as ``solve_ivp`` does, testing the
+    run's steady state at its check times k ``check`` on the dense output:
+    ``steady.update(t, *measure(t, y))``, measure giving (rate, monitor). Stops steady,
+    at the solver's end or failure, or ``cap`` s of wall time after ``start``. Returns
+    (converged, reason, steps, t, y): t, y the last state checked (y None: none)."""
+    k, converged, reason, steps, t, y = 1, False, "not steady by t_end", 0, 0.0, None
+    while solver.status == "running":
+        if time.perf_counter() - start > cap:
+            reason = f"stopped at the {cap:g} s wall-time cap at t = {solver.t:.4g} s"
+            break
+        solver.step()
+        steps += 1
+        if solver.status == "failed":
+            reason = f"solver failed at t = {solver.t:.4g} s"
+            break
+        if solver.t >= k * check:
+            dense = solver.dense_output()
+            while k * check <= solver.t and not converged:
+                t = k * check
+                y = dense(t)
+                converged = steady.update(t, *measure(t, y))
+                k += 1
+            if converged:
+                reason = "steady"
+                break
+    return converged, reason, steps, t, y
+
+
 def run_transient_peer(sim: Simulation, method: str = "Radau", rtol: float | None = None,
                        max_wall: float = 600.0, atol_factor: float = 1.0) -> PeerResult:
     """scipy's Radau or BDF with the analytic sparse Jacobian, from rest to steady state.
@@ -235,29 +264,17 @@ def run_transient_peer(sim: Simulation, method: str = "Radau", rtol: float | Non
     steady, check, t_end = sim.steady, sim.check, sim.numerics.t_end
     solver = solver_class(sysm.rhs, 0.0, np.zeros(4 * n), t_end, rtol=rtol,
                           atol=atol_factor * rtol * _state_scale(sim, n), jac=sysm.jacobian)
-    k, total, converged, reason, steps = 1, 0.0, False, "not steady by t_end", 0
-    while solver.status == "running":
-        if time.perf_counter() - start > max_wall:
-            reason = f"stopped at the {max_wall:g} s wall-time cap at t = {solver.t:.4g} s"
-            break
-        solver.step()
-        steps += 1
-        if solver.status == "failed":
-            reason = f"solver failed at t = {solver.t:.4g} s"
-            break
-        if solver.t >= k * check:
-            dense = solver.dense_output()
-            while k * check <= solver.t and not converged:
-                t = k * check
-                y = dense(t)
-                total = sysm.total_friction(t, y)
-                rates = y[2 * n:]
-                rate = max(np.abs(rates[0::2]).max(), P.L * np.abs(rates[1::2]).max()) / vel
-                converged = steady.update(t, rate, total)
-                k += 1
-            if converged:
-                reason = "steady"
-                break
+    totals = [0.0]
+
+    def measure(t, y):
+        totals[0] = sysm.total_friction(t, y)
+        rates = y[2 * n:]
+        return (max(np.abs(rates[0::2]).max(), P.L * np.abs(rates[1::2]).max()) / vel,
+                totals[0])
+
+    converged, reason, steps, _, _ = step_to_steady(solver, steady, check, max_wall, start,
+                                                    measure)
+    total = totals[0]
     wall = time.perf_counter() - start
     return PeerResult(total, wall, converged, reason, rtol, solver.t, solver.nfev,
                       solver.njev, solver.nlu, steps)

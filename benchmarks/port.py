@@ -50,7 +50,13 @@ from beltsim.solvers.implicit import (
     SAFETY,
     ImplicitScheme,
 )
-from beltsim.solvers.newton import CONTRACTION, LAW_GAP, NEAR_BOUND, ROUNDOFF_FLOOR
+from beltsim.solvers.newton import (
+    CONTRACTION,
+    LAW_GAP,
+    NEAR_BOUND,
+    ROUNDOFF_FLOOR,
+    SLIP_GAP,
+)
 
 from .peers import FixedPattern, coo_parts
 
@@ -188,20 +194,28 @@ class PortScheme(Scheme):
         lam[jc] = np.minimum(LAM_MAX, np.maximum(-LAM_MAX, lj + dl))
         return float(np.abs(dl).max()) if dl.size else 0.0
 
-    def release_stuck_ratios(self, lam, lam0, asm):
-        """Vectorised :func:`beltsim.solvers.newton.release_stuck_ratios`."""
+    def release_stuck_ratios(self, lam, lam0, asm, growing):
+        """Vectorised :func:`beltsim.solvers.newton.release_stuck_ratios`: the largest
+        change."""
         jc, code = self.jc, self.disc.model.law
         lj = lam[jc]
         cand = (asm.sg < NEAR_BOUND) & (lj * asm.rl < 0.0)
         if not cand.any():
-            return False
+            return 0.0
         s = asm.rl[cand] + law_inverse_numpy(code, lam0[cand])[0]
-        off = np.abs(law_numpy(code, s)[0] - lj[cand]) > LAW_GAP
+        g = law_numpy(code, s)[0]
+        if growing:
+            off = np.abs(law_inverse_numpy(code, lj[cand])[0] - s) > SLIP_GAP
+            new = np.clip(g[off], -LAM_MAX, LAM_MAX)
+        else:
+            off = np.abs(g - lj[cand]) > LAW_GAP
+            new = np.zeros(int(off.sum()))
         if not off.any():
-            return False
+            return 0.0
         idx = jc[cand][off]
-        lam[idx] = 0.0
-        return True
+        big = float(np.abs(new - lam[idx]).max())
+        lam[idx] = new
+        return big
 
     def newton(self, state, old, inv_dt, t):
         """Vectorised :func:`beltsim.solvers.newton.newton` (primal-dual branch)."""
@@ -229,9 +243,15 @@ class PortScheme(Scheme):
             th[1:-1] += dx[:, 1]
             update = max(step, dlam)
             rate = update / previous if it > 0 and previous > 0.0 else 1.0
-            if ((update < tol or (update < ROUNDOFF_FLOOR * tol and update > 0.5 * previous)
-                    or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol))
-                    and not self.release_stuck_ratios(lam, lam0, asm)):
+            converged = (update < tol
+                         or (update < ROUNDOFF_FLOOR * tol and update > 0.5 * previous)
+                         or (rate < CONTRACTION and rate / (1.0 - rate) * update < tol))
+            if converged or update > previous:
+                moved = self.release_stuck_ratios(lam, lam0, asm, not converged)
+                if moved > 0.0:
+                    update = max(update, moved)
+                    converged = False
+            if converged:
                 d = self.disc
                 vrel = np.zeros(self.jc.size)  # the forces of the ratios alone
                 fnode[:] = reference.friction(vrel, t, d.mesh, d.model, d.drive, lam)[0]

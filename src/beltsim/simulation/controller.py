@@ -106,7 +106,7 @@ class Simulation:
                           if self.snapshot_interval else None)
         self.power = (PowerBalanceTracker() if hasattr(self.scheme, "work_integrals")
                       and not self.disc.closed else None)
-        self._measured = None
+        self._measured = self._solution = None
 
     arm_solves = 0  # the steady solves of a tensioner's search for its arm's rest angle
 
@@ -117,6 +117,7 @@ class Simulation:
         self.readout = readout_of(self.disc)
         self.scheme = solvers.get(self.disc.numerics.integrator)(self.disc)
         self.state = self.disc.new_state()
+        self._measured = self._solution = None
 
     # views ------------------------------------------------------------
     @property
@@ -164,9 +165,13 @@ class Simulation:
         return self._measured
 
     def solution(self):
-        """The state now, read as a solution (fields, totals, the layout's figures)."""
-        # a steady solve's state is the final drive's, whatever the clock says
-        return self.readout.solution(self.state, self.t, self.scheme.transient)
+        """The state now, read as a solution (fields, totals, the layout's figures); one
+        object a check (the trackers read it in turn), made anew after the state moves."""
+        if self._solution is None:
+            # a steady solve's state is the final drive's, whatever the clock says
+            self._solution = self.readout.solution(self.state, self.t,
+                                                   self.scheme.transient)
+        return self._solution
 
     # stepping ---------------------------------------------------------
     def warm_up(self, notice: bool = False) -> float:
@@ -189,7 +194,7 @@ class Simulation:
     def advance(self, t_stop: float, max_steps: int = 10**9) -> None:
         """Step until t >= t_stop (transient schemes); raises NumericalError on failure."""
         self.t = self.scheme.advance(self.state, self.t, t_stop, max_steps)
-        self._measured = None
+        self._measured = self._solution = None
 
     def trackers(self, progress=False, handle_signals=False, callback=None,
                  checkpoint=None, extra=()) -> list[Tracker]:
@@ -308,7 +313,7 @@ class Simulation:
         self.state.assign(state)
         self.t = t
         self.scheme.restore(scheme)
-        self._measured = None
+        self._measured = self._solution = None
 
     def _run_steady(self, raise_on_failure, compile_time, trackers=()):
         # a steady solve makes no checks: its trackers start and end around it
@@ -327,7 +332,7 @@ class Simulation:
                 raise
         finally:
             self.wall_time = time.perf_counter() - start
-            self._measured = None
+            self._measured = self._solution = None
             for tr in trackers:
                 tr.finalize(self, status)
         return self._result(status, reason, compile_time, failure)

@@ -88,6 +88,52 @@ def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
 
 
 @njit(cache=True, no_cpython_wrapper=True)
+def block_substitute_many(w, r, x):
+    """:func:`beltsim.solvers.newton.block_substitute` for each right-hand side r[q]
+    (m, n, 2) into x[q], the same arithmetic in the same order: the columns interleave,
+    each row's factors loaded once for all of them, and the columns' recurrences (each a
+    chain of dependent steps) overlap. For the border's columns (w: a Newton
+    workspace with the band's factors)."""
+    C, W, Ub, W2 = w.C, w.W, w.U, w.W2
+    m, n = r.shape[0], r.shape[1]
+    for i in range(n):
+        if i == 0:
+            for q in range(m):
+                x[q, 0, 0], x[q, 0, 1] = r[q, 0, 0], r[q, 0, 1]
+            continue
+        w00, w01, w10, w11 = W[i, 0, 0], W[i, 0, 1], W[i, 1, 0], W[i, 1, 1]
+        if i > 1:
+            v00, v01, v10, v11 = W2[i, 0, 0], W2[i, 0, 1], W2[i, 1, 0], W2[i, 1, 1]
+            for q in range(m):
+                y0, y1 = x[q, i - 1, 0], x[q, i - 1, 1]
+                z0 = r[q, i, 0] - w00 * y0 - w01 * y1
+                z1 = r[q, i, 1] - w10 * y0 - w11 * y1
+                z0 -= v00 * x[q, i - 2, 0] + v01 * x[q, i - 2, 1]
+                z1 -= v10 * x[q, i - 2, 0] + v11 * x[q, i - 2, 1]
+                x[q, i, 0], x[q, i, 1] = z0, z1
+        else:
+            for q in range(m):
+                y0, y1 = x[q, i - 1, 0], x[q, i - 1, 1]
+                x[q, i, 0] = r[q, i, 0] - w00 * y0 - w01 * y1
+                x[q, i, 1] = r[q, i, 1] - w10 * y0 - w11 * y1
+    for i in range(n - 1, -1, -1):
+        c00, c01, c10, c11 = C[i, 0, 0], C[i, 0, 1], C[i, 1, 0], C[i, 1, 1]
+        if i < n - 1:
+            u00, u01, u10, u11 = Ub[i, 0, 0], Ub[i, 0, 1], Ub[i, 1, 0], Ub[i, 1, 1]
+            for q in range(m):
+                x0, x1 = x[q, i + 1, 0], x[q, i + 1, 1]
+                z0 = x[q, i, 0] - (u00 * x0 + u01 * x1)
+                z1 = x[q, i, 1] - (u10 * x0 + u11 * x1)
+                x[q, i, 0] = c00 * z0 + c01 * z1
+                x[q, i, 1] = c10 * z0 + c11 * z1
+        else:
+            for q in range(m):
+                z0, z1 = x[q, i, 0], x[q, i, 1]
+                x[q, i, 0] = c00 * z0 + c01 * z1
+                x[q, i, 1] = c10 * z0 + c11 * z1
+
+
+@njit(cache=True, no_cpython_wrapper=True)
 def border_row_dot(bd, r, y):
     """sum over the band's rows i and unknowns a of Cm[r, i, a] y[i, a]: a border node's
     row reaches only the band's rows 0, ni - 2 and ni - 1 (:func:`gather`), a global's
@@ -108,11 +154,14 @@ def border_row_dot(bd, r, y):
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def schur(bd):
     """bd.Sinv from bd.X = A^{-1} Bm; False when the complement is singular."""
-    nb = bd.Dm.shape[0]
+    nb, ni, b = bd.X.shape
     S = bd.Dm.copy()
-    for r in range(nb):
+    for r in range(2 * b):  # the border nodes' rows: three band rows each
         for q in range(nb):
             S[r, q] -= border_row_dot(bd, r, bd.X[q])
+    if nb > 2 * b:  # the globals' rows, dense: one matrix product (BLAS)
+        S[2 * b:, :] -= np.dot(bd.Cm[2 * b:].reshape(nb - 2 * b, ni * b),
+                               bd.X.reshape(nb, ni * b).T)
     # scale rows and columns to unit diagonal-ish size: the border mixes metres, N and 1/s
     d = np.ones(nb)
     for r in range(nb):
@@ -147,8 +196,11 @@ def finish(bd, r, rg, x, dg):
         bd.rb[b + a] = r[n - 1, a]
     for k in range(nb - 2 * b):
         bd.rb[2 * b + k] = rg[k]
-    for q in range(nb):
+    for q in range(2 * b):
         bd.rb[q] -= border_row_dot(bd, q, x)
+    if nb > 2 * b:  # the globals' rows, dense (BLAS)
+        bd.rb[2 * b:] -= np.dot(bd.Cm[2 * b:].reshape(nb - 2 * b, ni * b),
+                                x[:ni].reshape(ni * b))
     z = bd.Sinv @ bd.rb
     for q in range(nb):
         for i in range(ni):

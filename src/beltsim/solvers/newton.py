@@ -20,6 +20,7 @@ from ..errors import FailureKind, NumericalError
 from ..physics.friction import EXACT, is_exact, law, law_inverse
 from ..physics.model import (
     JACOBIAN,
+    LAM_MAX,
     add_stick_penalty,
     assemble,
     bound_scale,
@@ -28,7 +29,7 @@ from ..physics.model import (
 )
 from ..problem.drive import friction_factor
 from .base import Scheme
-from .border import Border, finish, gather, schur
+from .border import Border, block_substitute_many, finish, gather, schur
 from .ssn import Saddle, project, saddle_solve, saddle_system
 
 # status codes of the time-stepping kernels that solve with Newton
@@ -49,9 +50,12 @@ ROUNDOFF_MERIT = 1e-26
 CYCLE_ITERATIONS = 8
 MAX_HALVINGS = 8
 # A friction ratio with slope dlam/ds below NEAR_BOUND (|lam| > 0.995 for tanh) that
-# differs from the law at its slip velocity by more than LAW_GAP is stuck at the bound
+# differs from the law at its slip velocity by more than LAW_GAP is stuck at the bound;
+# while Newton's updates grow, one whose g^-1(lam) lies beyond that slip velocity (over
+# v_reg) by more than SLIP_GAP
 NEAR_BOUND = 1e-2
 LAW_GAP = 1e-3
+SLIP_GAP = 0.1
 
 #: Counters a scheme accumulates, one record the kernels update in place.
 STATS_DTYPE = np.dtype([("newton_iterations", np.int64), ("failed_steps", np.int64),
@@ -238,8 +242,7 @@ def factorise_bordered(w, bd):
     if not block_factor(w.Lb[:ni], w.Db[:ni], w.Ub[:ni], w):
         return False
     gather(w.Lb, w.L2, w.Db, w.Ub, w.Gc, w.Gr, w.Gd, bd)
-    for q in range(bd.Bm.shape[0]):
-        block_substitute(w, bd.Bm[q], bd.X[q])
+    block_substitute_many(w, bd.Bm, bd.X)
     return schur(bd)
 
 
@@ -267,25 +270,37 @@ def friction_forces(lam, fnode, u, g, t, mesh, p, drive):
 
 
 @njit(cache=True, no_cpython_wrapper=True)
-def release_stuck_ratios(lam, w, mesh, code):
-    """Restart the friction ratios stuck at +-1 against their slip velocity; any?
+def release_stuck_ratios(lam, w, mesh, code, growing):
+    """Restart the friction ratios stuck near +-1 against their slip velocity; returns
+    the largest change (0: none).
 
     Near the bound the dual update sg (rl + ...) is tiny (slope sg = 1 - lam^2 for tanh)
     even when the slip velocity has turned: a node leaving the slip at a stick
     transition stays at lam = -1 with v_rel / v_reg = +50, and the updates pass every
-    convergence test. Such a ratio (sg below NEAR_BOUND, off g(v_rel / v_reg) of the
-    iterate before the update by more than LAW_GAP) is not converged: it restarts from
-    0, where the slope is largest (from the bound the update grows only by a factor
-    1 + 2 abs(rl) per iteration), and Newton goes on.
+    convergence test. At convergence, such a ratio (sg below NEAR_BOUND, off
+    g(v_rel / v_reg) of the iterate before the update by more than LAW_GAP) is not
+    converged: it restarts from 0, where the slope is largest (from the bound the update
+    grows only by a factor 1 + 2 abs(rl) per iteration), and Newton goes on. While the
+    updates grow (``growing``: a ratio the fraction-to-the-boundary rule took near the
+    bound coming back, some ten iterations), a ratio whose g^-1(lam) lies beyond that
+    slip velocity by more than SLIP_GAP is set to the law's value there instead.
     """
-    stuck = False
+    big = 0.0
     for j in mesh.cn:
         if w.sg[j] < NEAR_BOUND and lam[j] * w.rl[j] < 0.0:
             s = w.rl[j] + law_inverse(code, w.lam0[j])[0]
-            if abs(law(code, s)[0] - lam[j]) > LAW_GAP:
-                lam[j] = 0.0
-                stuck = True
-    return stuck
+            g = law(code, s)[0]
+            if growing:
+                if abs(law_inverse(code, lam[j])[0] - s) <= SLIP_GAP:
+                    continue
+                g = min(LAM_MAX, max(-LAM_MAX, g))
+            elif abs(g - lam[j]) > LAW_GAP:
+                g = 0.0
+            else:
+                continue
+            big = max(big, abs(g - lam[j]))
+            lam[j] = g
+    return big
 
 
 @njit(cache=True, inline="always")
@@ -354,12 +369,20 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
                 th[i + off] += dx[i, 1]
             for k in range(ng):
                 g[k] += dg[k]
-            update = max(step, dlam)
             if not np.isfinite(dlam):  # a ratio started on the bound, where g^-1 is not
                 st.merit = merit(R, Rg, scales)
                 return False
-            if (update_converged(update, previous, it, tol)
-                    and not release_stuck_ratios(lam, w, mesh, p.law)):
+            update = max(step, dlam)
+            converged = update_converged(update, previous, it, tol)
+            # a stuck ratio: sought at convergence, and wherever the updates grow (a
+            # ratio near the bound coming back slowly); sought at every iteration, its
+            # moves cycled with the updates that take it to the bound
+            if converged or update > previous:
+                moved = release_stuck_ratios(lam, w, mesh, p.law, not converged)
+                if moved > 0.0:
+                    update = max(update, moved)
+                    converged = False
+            if converged:
                 friction_forces(lam, fnode, u, g, t, mesh, p, drive)
                 return True
             assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)

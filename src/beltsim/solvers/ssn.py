@@ -232,6 +232,36 @@ def saddle_substitute(s, r, y):
             y[i, a] = s.C[i, a, 0] * z[0] + s.C[i, a, 1] * z[1] + s.C[i, a, 2] * z[2]
 
 
+@njit(cache=True, no_cpython_wrapper=True)
+def saddle_substitute_many(s, r, y):
+    """:func:`saddle_substitute` for each right-hand side r[q] (m, n, 3) into y[q], the
+    same arithmetic in the same order, the columns interleaved (each row's factors read
+    once for all of them; the columns' recurrences overlap)."""
+    m, n = r.shape[0], r.shape[1]
+    z = np.empty(3)
+    for i in range(n):
+        for q in range(m):
+            for a in range(3):
+                acc = r[q, i, a]
+                if i > 0:
+                    for b in range(3):
+                        acc -= s.W[i, a, b] * y[q, i - 1, b]
+                if i > 1:
+                    for b in range(3):
+                        acc -= s.W2[i, a, b] * y[q, i - 2, b]
+                y[q, i, a] = acc
+    for i in range(n - 1, -1, -1):
+        for q in range(m):
+            for a in range(3):
+                acc = y[q, i, a]
+                if i < n - 1:
+                    for b in range(3):
+                        acc -= s.Ub[i, a, b] * y[q, i + 1, b]
+                z[a] = acc
+            for a in range(3):
+                y[q, i, a] = s.C[i, a, 0] * z[0] + s.C[i, a, 1] * z[1] + s.C[i, a, 2] * z[2]
+
+
 @njit(cache=True)
 def saddle_solve(s, mesh):
     """Factorise the system (bordered on a loop) and solve it: s.dx (and s.dg) from s.R
@@ -258,8 +288,7 @@ def saddle_solve_bordered(s, bd):
     if not saddle_factor(s, ni):
         return False
     gather(s.Lb, s.L2, s.Db, s.Ub, s.Gc, s.Gr, s.Gd, bd)
-    for q in range(bd.Bm.shape[0]):
-        saddle_substitute(s, bd.Bm[q], bd.X[q])
+    saddle_substitute_many(s, bd.Bm, bd.X)
     if not schur(bd):
         return False
     saddle_substitute(s, s.R[:ni], s.dx[:ni])
