@@ -222,11 +222,11 @@ def test_the_beam_on_a_back_side_idler_tends_to_the_string_and_balances_its_powe
 @pytest.mark.verification
 def test_a_load_step_on_one_accessory_moves_the_drive_and_the_arm_between_exact_states():
     """The accessory drive with its tensioner: the alternator's load steps from 2.5 to
-    4 N m half a second after the start-up's ramp. Before the step the history passes through the creep
-    theory's state with the old load, though the grid's arcs are laid at the final arm
-    angle, 8e-3 rad away (measured: span tensions within 3.6e-5, the arm within 4.5e-5
-    rad; bounds 2e-4), and the run ends on the new loads' state to the grid's error (400
-    elements: 2.3e-6; bound 1e-5)."""
+    4 N m half a second after the start-up's ramp. Before the step the history passes
+    through the creep theory's state with the old load, though the grid's arcs are laid
+    at the final arm angle, 8e-3 rad away (measured: span tensions within 3.6e-5, the arm
+    within 4.5e-5 rad; bounds 2e-4), and the run ends on the new loads' state to the
+    grid's error (400 elements: 2.3e-6; bound 1e-5)."""
     over = {"numerics.integrator": "esdirk3", "numerics.elements": 400,
             "numerics.ramp_time": 0.3,
             "pulley.alternator.load_torque": [[0.0, 0.0], [0.3, 2.5], [0.8, 2.5],
