@@ -24,15 +24,27 @@ def test_import_beltsim_leaves_numba_scipy_and_matplotlib_for_later():
     assert json.loads(proc.stdout) == []
 
 
-def test_the_exact_solution_of_a_stick_scene_leaves_scipy_optimize_for_the_slip_front():
-    """`beltsim analytic` of a perfect-adhesion scene, and beltsim.solve of one, do not
-    wait for scipy.optimize (0.3-0.5 s to import): only a slip front's root needs it."""
-    code = ("import sys, beltsim; beltsim.solve(beltsim.paper_scene('{}')); "
+def test_the_exact_solutions_leave_scipy_optimize_out():
+    """`beltsim analytic` and beltsim.solve of a scene, a slip front's included, do not
+    wait for scipy.optimize (0.3-0.5 s to import): the roots are beltsim's own
+    (problem.roots, Brent's method step for step as scipy's)."""
+    code = ("import sys, beltsim; beltsim.solve(beltsim.shipped_scene('{}')); "
             "print('scipy.optimize' in sys.modules)")
-    for scene, wanted in (("quasistatic", "False"), ("slip", "True")):
+    for scene in ("paper_quasistatic", "paper_slip", "drive_flat", "serpentine_tensioner"):
         proc = subprocess.run([sys.executable, "-c", code.format(scene)], capture_output=True,
                               text=True, timeout=120, check=True)
-        assert proc.stdout.strip() == wanted, scene
+        assert proc.stdout.strip() == "False", scene
+
+
+def test_a_runs_modules_leave_scipy_optimize_and_sparse_out():
+    """What `beltsim run` imports before its kernels: no scipy.optimize (0.3-0.5 s) and no
+    scipy.sparse (0.1 s), which only the linearisation, the modes and the peers need."""
+    code = ("import sys, beltsim.cli, beltsim.simulation.controller, beltsim.io.results, "
+            "beltsim.simulation.progress; "
+            "print(sorted(m for m in ('scipy.optimize', 'scipy.sparse') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120, check=True)
+    assert proc.stdout.strip() == "[]"
 
 
 def test_the_lazy_names_and_subpackages_resolve():

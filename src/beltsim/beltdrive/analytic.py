@@ -31,17 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import NoSolutionError
+from ..problem.roots import brentq
 from .figures import layout_summary
 from .geometry import SEGMENTS
 from .params import DriveParams
 
-
-def brentq(*args, **kwargs):
-    """scipy.optimize.brentq, imported when a root is solved: a run of the straight belt
-    imports this module but solves nothing here, and scipy.optimize costs it 0.4 s."""
-    from scipy.optimize import brentq as root
-
-    return root(*args, **kwargs)
 
 class GrossSlipError(NoSolutionError):
     """The load exceeds what the drive carries: no steady state (``capacity`` in N m)."""

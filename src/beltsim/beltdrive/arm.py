@@ -32,6 +32,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as C
 
 from ..errors import NoSolutionError
+from ..problem.roots import brentq
 from .pulleys import GeometryError
 
 #: The tabled travel of the arm on either side of its reference and rest angles (rad)
@@ -122,8 +123,6 @@ def rest_angle(P, table: ArmTable) -> tuple[float, float]:
     NoSolutionError
         No rest angle in the tabled travel.
     """
-    from scipy.optimize import brentq
-
     ten = P.tensioner
     L = P.layout.loop_length
 

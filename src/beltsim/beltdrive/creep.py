@@ -38,7 +38,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import NoSolutionError, SceneError
-from .analytic import GrossSlipError, LiftOffError, brentq
+from ..problem.roots import brentq
+from .analytic import GrossSlipError, LiftOffError
 from .figures import hub_loads, layout_summary
 from .params import DriveParams
 from .pulleys import PulleyLayout

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import NoSolutionError, SceneError
+from ..problem.roots import brentq
 from ..problem.rules import Rule, show
 from .pulley_tables import CentreRule, checked_keys
 from .pulleys import GeometryError, PulleyLayout
@@ -130,8 +131,6 @@ def equilibrium(ten: Tensioner, layout: PulleyLayout, at, hub_of, beta0: float =
     NoSolutionError
         No equilibrium within half a turn ("tensioner: no equilibrium ...").
     """
-    from scipy.optimize import brentq  # here: a run without a tensioner never needs it
-
     solved = {}  # the root's own solve is brentq's last call: kept, not repeated
 
     def solve(beta):

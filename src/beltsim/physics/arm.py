@@ -40,16 +40,21 @@ def chebyshev(coef, row, x):
 
 
 @njit(cache=True)
-def arm_values(beta, mesh):
-    """(delta, slope, curvature): arrays (2) of delta_a, delta_b and their first and
-    second derivatives at beta (rad from the reference)."""
-    par = mesh.arm_par
+def chebyshev_values(beta, coef, par):
+    """:func:`arm_values` of the Mesh's arm_coef and arm_par."""
     x = (2.0 * beta - par[LO] - par[HI]) / (par[HI] - par[LO])
     out = np.empty((3, 2))
     for r in range(3):
         for s in range(2):
-            out[r, s] = chebyshev(mesh.arm_coef, 2 * r + s, x)
+            out[r, s] = chebyshev(coef, 2 * r + s, x)
     return out[0], out[1], out[2]
+
+
+@njit(cache=True)
+def arm_values(beta, mesh):
+    """(delta, slope, curvature): arrays (2) of delta_a, delta_b and their first and
+    second derivatives at beta (rad from the reference)."""
+    return chebyshev_values(beta, mesh.arm_coef, mesh.arm_par)
 
 
 @njit(cache=True, inline="always")
@@ -88,9 +93,29 @@ def arm_torque(beta, omega, ta, tb, slope, mesh):
 
 
 @njit(cache=True, no_cpython_wrapper=True)
-def arm_rows(u, g, mesh, p, w, want_jac):
+def arm_stretch(bd, g, arm_idx, arm_coef, arm_par):
+    """(delta, slope) of :func:`arm_values` at the arm's angle in the globals g; zeros
+    without an arm (``arm_*``: the Mesh's).
+
+    ``bd`` is the workspace's border: None on an open layout's, which has no arm; its
+    type prunes the body, so an open layout compiles none of the arm's kernels. (The
+    mesh's arrays, not the mesh: a kernel's compile grows with the arrays its arguments
+    hold.)
+    """
+    if bd is None:
+        return np.zeros(2), np.zeros(2)
+    if arm_idx.shape[0] == 0:
+        return np.zeros(2), np.zeros(2)
+    delta, slope, _ = chebyshev_values(g[arm_idx[0]], arm_coef, arm_par)
+    return delta, slope
+
+
+@njit(cache=True, no_cpython_wrapper=True)
+def arm_rows(u, g, mesh, p, w, bd, want_jac):
     """Add the arm's two global rows (their rates excepted: assemble's, through
-    ``mesh.inertia``) and their slopes."""
+    ``mesh.inertia``) and their slopes (``bd`` as in :func:`arm_stretch`)."""
+    if bd is None:
+        return
     ib, ia, jb = mesh.arm_idx[0], mesh.arm_idx[1], mesh.arm_idx[2]
     iw = ib + 1
     par = mesh.arm_par

@@ -41,7 +41,7 @@ import numpy as np
 from numba import njit
 
 from ..problem.drive import friction_factor, mismatch, value, value_at
-from .arm import arm_rows, arm_values, stretch
+from .arm import arm_rows, arm_stretch, stretch
 
 # Loads and State are not used here: numba's cache indexes written before they moved to
 # physics.discrete name them here, and unpickling such an index must find them, or every
@@ -218,24 +218,14 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
     rim = value(drive.speed, t)
     lk, l0, l1, m0, m1 = hermite_weights(loads.times, t)
     code, dual = p.law, p.dual
-    ng = g.shape[0]
     arm = mesh.arm_idx.shape[0] > 0
-    if arm:  # a tensioner's arm: its spans' stretch (physics.arm)
-        adelta, aslope, _ = arm_values(g[mesh.arm_idx[0]], mesh)
-    else:
-        adelta = aslope = np.zeros(2)
+    # a tensioner's arm: its spans' stretch
+    adelta, aslope = arm_stretch(w.border, g, mesh.arm_idx, mesh.arm_coef, mesh.arm_par)
     for j in range(nn):
         fnode[j] = 0.0
     if closed:
-        w.Rg[0] = 0.0
-        for k in range(1, ng):
-            w.Rg[k] = mesh.inertia[k] * (g[k] - old.g[k]) * inv_dt + value_at(drive.load, k, t)
-        if want_jac:
-            w.Gc[:, :, :] = 0.0
-            w.Gr[:, :, :] = 0.0
-            w.Gd[:, :] = 0.0
-            for k in range(1, ng):
-                w.Gd[k, k] = mesh.inertia[k] * inv_dt
+        start_global_rows(w.border, w.Rg, w.Gc, w.Gr, w.Gd, g, old.g, inv_dt, t,
+                          mesh.inertia, drive.load, want_jac)
     for i in range(n):
         j = i + off
         jm = j - 1 if j > 0 else nn - 1
@@ -334,8 +324,8 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
             ru += wj * S * (lam[j] + sg[j] * rl[j])
             rt += hh * wj * S * (lam[j] + sg[j] * rl[j])
             if want_jac:
-                add_friction_slope(w, i, j, friction_stiffness(wj, S, sg[j], p), inv_dt, c,
-                                   hh, sw)
+                add_friction_slope(L2, Lb, Db, i, j, friction_stiffness(wj, S, sg[j], p),
+                                   inv_dt, c, hh, sw)
             if closed:
                 loop_friction(w, w.border, i, j, s, lam[j] + sg[j] * rl[j],
                               friction_stiffness(wj, S, sg[j], p), dSe, dSc, S, inv_dt, c, hh,
@@ -343,7 +333,28 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
         R[i, 0] = ru
         R[i, 1] = rt
     if arm:
-        arm_rows(u, g, mesh, p, w, want_jac)
+        arm_rows(u, g, mesh, p, w, w.border, want_jac)
+
+
+@njit(cache=True, no_cpython_wrapper=True)
+def start_global_rows(bd, Rg, Gc, Gr, Gd, g, g_old, inv_dt, t, inertia, loads, want_jac):
+    """A loop's global rows before its nodes' terms: the free pulleys' J omega_t and
+    loads (``loads``: the drive's), and the slopes' start. ``bd`` is the workspace's
+    border: None on an open layout's, which never comes here; its type prunes the body.
+    (The workspace's arrays, not the workspace: a kernel's compile grows with the arrays
+    its arguments hold.)"""
+    if bd is None:
+        return
+    ng = g.shape[0]
+    Rg[0] = 0.0
+    for k in range(1, ng):
+        Rg[k] = inertia[k] * (g[k] - g_old[k]) * inv_dt + value_at(loads, k, t)
+    if want_jac:
+        Gc[:, :, :] = 0.0
+        Gr[:, :, :] = 0.0
+        Gd[:, :] = 0.0
+        for k in range(1, ng):
+            Gd[k, k] = inertia[k] * inv_dt
 
 
 @njit(cache=True, no_cpython_wrapper=True)
@@ -435,7 +446,7 @@ def add_stick_penalty(w, inv_dt, fs, c, mesh, p):
         S = fs if mesh.off == 1 else w.bs[j]
         k = friction_stiffness(mesh.wf[j], S, w.sg[j], p)
         hf = p.half_height * mesh.face[j]
-        add_friction_slope(w, j - mesh.off, j, k, inv_dt, c, hf, mesh.sw)
+        add_friction_slope(w.L2, w.Lb, w.Db, j - mesh.off, j, k, inv_dt, c, hf, mesh.sw)
         if mesh.off == 0:
             loop_friction(w, w.border, j, j, mesh.seg[j], 0.0, k, 0.0, 0.0, S, inv_dt, c,
                           hf, mesh, p, JACOBIAN)
@@ -453,13 +464,15 @@ def stencil_band(o, L2, Lb, Db):
 
 
 @njit(cache=True, no_cpython_wrapper=True)
-def add_friction_slope(w, i, j, k, inv_dt, c, hh, sw):
-    """Add to row block i the Jacobian of a nodal force -k v_rel,j (k = -dF_j/dv_rel)."""
+def add_friction_slope(L2, Lb, Db, i, j, k, inv_dt, c, hh, sw):
+    """Add to row block i of the Jacobian's bands the slope of a nodal force -k v_rel,j
+    (k = -dF_j/dv_rel). (The bands, not the workspace: a kernel's compile grows with the
+    arrays its arguments hold, and the workspace holds some thirty.)"""
     for o in range(3):
         dd = k * slip_velocity_slope(sw, j, o, c, inv_dt)
         if dd == 0.0:
             continue
-        blk = stencil_band(o, w.L2, w.Lb, w.Db)
+        blk = stencil_band(o, L2, Lb, Db)
         blk[i, 0, 0] += dd
         blk[i, 0, 1] += dd * hh
         blk[i, 1, 0] += dd * hh

@@ -26,16 +26,18 @@ stuck nodes and none at the sliding ones.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..problem.drive import friction_factor, mismatch, value, value_at
 from .arm import table_values
 from .discrete import CENTRAL, Mesh, ModelParams, State, hermite_weights
 from .friction import ADHESION, AUGMENTATION, is_exact, law_numpy
 from .model import POWER_TERMS
+
+if TYPE_CHECKING:  # scipy.sparse is imported where a matrix is built: a run reads
+    import scipy.sparse as sp  # only this module's strains, and scipy.sparse costs 0.1 s
 
 
 class Operators(NamedTuple):
@@ -171,6 +173,8 @@ def _fields(n, offset, u_entries, t_entries):
 
 
 def _matrix(n, parts):
+    import scipy.sparse as sp
+
     rows, cols, vals = (np.concatenate(x) for x in zip(*parts))
     return sp.csr_matrix((vals, (rows, cols)), shape=(2 * n, 2 * n))
 
@@ -219,6 +223,8 @@ def friction_pattern(mesh: Mesh, p: ModelParams) -> FrictionPattern:
 
 def friction_matrices(k, pattern: FrictionPattern, n):
     """The friction's parts (K_f, C_f) of -df/dq and -df/dq' at stiffnesses k (2n, 2n)."""
+    import scipy.sparse as sp
+
     vals = k[pattern.node] * pattern.coef
     full = sp.csr_matrix((vals, (pattern.rows, pattern.cols)), shape=(2 * n, 4 * n))
     return full[:, :2 * n], full[:, 2 * n:]
@@ -226,6 +232,8 @@ def friction_matrices(k, pattern: FrictionPattern, n):
 
 def linearisation(u, th, ud, td, t, mesh: Mesh, p: ModelParams, drive, ratios=None):
     """(M, C, K) of the model linearised about the state (sparse; M diagonal)."""
+    import scipy.sparse as sp
+
     ops = operators(mesh, p)
     _, k = friction(slip_velocity(u, th, ud, td, t, mesh, p, drive), t, mesh, p, drive,
                     ratios)

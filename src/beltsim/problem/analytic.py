@@ -53,6 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import NoSolutionError
+from .roots import brentq
 from .scene import Scene
 from .validation import Params
 
@@ -435,10 +436,6 @@ def solve_slip(P: Params) -> AnalyticSolution:
     zone can carry the load the whole contact slides (x* = x1) and that state is
     returned if the slip direction is consistent; otherwise NoSolutionError.
     """
-    # here, not at the top: scipy.optimize takes 0.3-0.5 s to import, which a straight
-    # belt with perfect adhesion or a command that solves no slip front need not wait for
-    from scipy.optimize import brentq
-
     if P.fstar is None:
         raise NoSolutionError("contact.max_friction: the slip solution needs a friction limit")
     ell = P.x2 - P.x1
