@@ -159,6 +159,7 @@ def test_a_transient_arm_needs_inertia():
 
 
 @pytest.mark.verification
+@pytest.mark.long
 @pytest.mark.parametrize("scheme", ["explicit", "implicit"])
 def test_every_transient_scheme_moves_the_arm_to_one_steady_state(scheme):
     """The explicit scheme (the arm's angle drifting with its rate, its rate kicked by
