@@ -43,7 +43,7 @@ CHECKS_PER_TRANSIT = 4  # checks per transit time L / c
 #: A warm-up that takes longer than this (s) compiles the kernels; loading them from
 #: numba's cache takes a fraction of a second
 COMPILING_AFTER = 2.0
-COMPILE_NOTICE = ("beltsim: compiling the numba kernels, once per install (about 30 s on "
+COMPILE_NOTICE = ("beltsim: compiling the numba kernels, once per install (30 to 40 s on "
                   "2 cores; later runs load them from the cache)")
 CHECKS_PER_PERIOD = 32  # at least, for a periodic drive (its extremes are read at checks)
 
