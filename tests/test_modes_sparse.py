@@ -60,8 +60,12 @@ def test_the_sparse_search_finds_the_dense_modes_and_least_stable(name, elements
         np.testing.assert_allclose(s.u, d.u, atol=SHAPE)
         rot = np.array([[d.pulleys[p][0], s.pulleys[p][0]] for p in d.pulleys])
         np.testing.assert_allclose(rot[:, 1], rot[:, 0], atol=SHAPE * np.max(np.abs(rot)))
-    assert _close(dense.least_stable, sparse.least_stable), (dense.least_stable,
-                                                             sparse.least_stable)
+    # the least stable rate; not its frequency: the belt's modes at 15.4 kHz form a
+    # cluster at one rate (-d/2), whose member the QZ's round-off (about 1 1/s there)
+    # makes the least stable is arbitrary (at 120 elements the dense pick is 38 rad/s
+    # from the sparse one)
+    assert (abs(dense.least_stable.real - sparse.least_stable.real)
+            <= BOUND * abs(dense.least_stable)), (dense.least_stable, sparse.least_stable)
 
 
 @pytest.mark.verification
