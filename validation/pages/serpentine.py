@@ -130,12 +130,12 @@ def beam_ladders(page: Page, rungs, quick: bool) -> None:
         "on a back-side idler the friction acts on the belt's other face) against the "
         "beam's exact steady state on N pulleys (`beltsim.beltdrive.exact_state`: "
         "piecewise exponentials on each span, stick and slip zone; theory page, \"The "
-        "beam on N pulleys\"). The tensions, hub loads, speed losses and the arm's "
-        "travel are held to the order floor; the slip arcs are reported: the run reads a "
-        "slip front by extrapolating the stick zone's friction ratio from two nodes "
-        "upstream, and the beam's ratio changes within a layer of width 1/alpha (about "
-        "3 mm here), which the ladder's cells do not resolve (the two-pulley beam shows "
-        "the same). Commands: "
+        "beam's exact steady state on N pulleys\"). The tensions, hub loads, speed losses"
+        " and the arm's travel are held to the order floor; the slip arcs are reported: "
+        "the run reads a slip front by extrapolating the stick zone's friction ratio from"
+        " two nodes upstream, and the beam's ratio changes within a layer of width "
+        "1/alpha (about 3 mm here), which the ladder's cells do not resolve (the two-"
+        "pulley beam shows the same). Commands: "
         + ", ".join(_cmd(s, "physics.model=beam", "numerics.integrator=steady",
                          "numerics.elements=N") for s in SCENES)
         + f" for N in {', '.join(map(str, rungs))}.")
