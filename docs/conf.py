@@ -73,7 +73,9 @@ numpydoc_xref_param_type = False
 numpydoc_validation_checks = {"GL08", "SS01"}
 # the built-in trackers' hooks inherit their docstrings from beltsim.Tracker, the schemes'
 # from solvers.base.Scheme (autodoc shows the inherited one; numpydoc validates their own)
+# LoopDiscretisation.arm: None by default, documented by its "#:" comment
 numpydoc_validation_exclude = {r"\.__init__$", r"\.__repr__$", r"\._",
+                               r"LoopDiscretisation\.arm$",
                                r"trackers\.\w+Tracker\.(initialize|handle|finalize|state|"
                                r"restore)$", r"trackers\.DivergenceGuard\.handle$",
                                r"solvers\.\w+\.\w+Scheme\.(advance|solve|dt|statistics|"

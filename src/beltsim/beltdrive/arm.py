@@ -4,7 +4,8 @@ changes, tabled for the kernels, and the drive's state at rest with the arm sett
 The grid is laid on the layout with the arm at a reference angle (the creep theory's
 rest angle of the running drive). Turning the arm by beta from there moves the tensioner
 pulley: spans a (arriving at it) and b (leaving it) change length and direction, and
-with them the wraps of the tensioner and its two neighbours. The loop's length changes by
+with them the wraps of the tensioner and its two neighbours. The loop's length changes
+by::
 
     delta_a(beta) + delta_b(beta),   delta_a = dl_a + (q_{k-1} - q_k) dphi_a,
                                       delta_b = dl_b + (q_k - q_{k+1}) dphi_b,
@@ -20,7 +21,7 @@ The moving spans' own inertia (axial frame motion, transverse swing) is not in t
 model, as it is not in the discrete model of Hwang, Perkins and Ulsoy.
 
 delta_a and delta_b are tabled as Chebyshev series on an interval of beta about the
-reference (:data:`TRAVEL`), which the run's arm must not leave.
+reference (``TRAVEL``), which the run's arm must not leave.
 """
 
 from __future__ import annotations

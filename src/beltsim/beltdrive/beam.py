@@ -377,7 +377,7 @@ def solve_beam(P: DriveParams, omega1: float | None = None,
 
     On two pulleys Newton starts from the string's closed-form state; where that fails,
     from a continuation in the load. On N pulleys (M2 then must be None: the loads are
-    the pulleys' own) it starts from the creep theory's state (:func:`_solve_layout`).
+    the pulleys' own) it starts from the creep theory's state (``_solve_layout``).
 
     Raises
     ------

@@ -49,7 +49,7 @@ def beam_state(P: DriveParams):
 
 def exact_state(P: DriveParams):
     """The exact steady state a drive's run is compared with: the beam's for the beam
-    model (:func:`beam_state`), the creep theory's for the string.
+    model (:func:`~beltsim.beltdrive.exact.beam_state`), the creep theory's for the string.
 
     Raises
     ------

@@ -7,7 +7,7 @@ span b (leaving it) by delta_b(beta). The grid keeps its nodes, and each span's 
 but its last two carry the stretch as a strain e = delta / l (``Mesh.arm_el``; l their
 length): an element's axial flux is B (u_x + e), so the belt's strain u_x + e stays
 continuous where the grid is stretched, and the friction stencils of the next arc, which
-reach two elements back, never see e. The globals' rows:
+reach two elements back, never see e. The globals' rows::
 
     beta' - omega = 0
     J omega' + d omega - tau0 + k_t (turn + beta) + (T_a - rho c^2) delta_a'

@@ -52,6 +52,7 @@ def blit_frames(fig, draw, frames, moving, dpi=None):
 
 
 def write_gif(path, frames_rgb, fps):
+    """Write the RGB frames (arrays) to a GIF at ``fps`` frames a second."""
     from PIL import Image
 
     first, *rest = (Image.fromarray(rgb) for rgb in frames_rgb)
@@ -62,6 +63,8 @@ def write_gif(path, frames_rgb, fps):
 
 
 def write_mp4(path, frames_rgb, fps):
+    """Write the RGB frames (an iterator of arrays) to an MP4 (ffmpeg, libx264) at ``fps``
+    frames a second."""
     import imageio_ffmpeg
 
     first = next(frames_rgb)
