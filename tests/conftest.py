@@ -32,6 +32,13 @@ if os.environ.get("NUMBA_BOUNDSCHECK", "0") not in ("", "0"):
         tempfile.gettempdir(), f"beltsim-numba-boundscheck-{_digest}"))
 
 
+# The runs' stability check (beltsim.simulation.stability) costs seconds per scene on a
+# clean cache: the suite's runs leave it off, and keep their cache out of the user's;
+# tests/test_stability.py turns it on where it is tested.
+os.environ.setdefault("BELTSIM_STABILITY", "0")
+os.environ.setdefault("BELTSIM_CACHE_DIR", tempfile.mkdtemp(prefix="beltsim-cache-"))
+
+
 #: The markers of pyproject.toml's [tool.pytest.ini_options]; a test carries one at least.
 KINDS = ("unit", "verification", "cli", "lab")
 

@@ -130,7 +130,8 @@ def paper_scene(name: str, overrides=()) -> Scene:
 
 
 def run(scene, progress: bool = False, raise_on_failure: bool = True,
-        snapshot_interval: float | None = None, trackers=(), overrides=()):
+        snapshot_interval: float | None = None, trackers=(), overrides=(),
+        stability: bool = True):
     """Run a scene of either kind from rest to steady state, against its exact one.
 
     Parameters
@@ -149,6 +150,9 @@ def run(scene, progress: bool = False, raise_on_failure: bool = True,
         The user's own trackers (:class:`beltsim.Tracker`), called at every check.
     overrides : dict, str or iterable of str or (str, value), optional
         Keys to set first.
+    stability : bool, optional
+        Check whether the steady state is stable in the model (``result.stability``);
+        seconds once per scene, then cached.
 
     Returns
     -------
@@ -170,9 +174,17 @@ def run(scene, progress: bool = False, raise_on_failure: bool = True,
     """
     from .simulation.controller import run as run_scene
 
-    return run_scene(load_scene(scene, overrides), progress=progress,
-                     raise_on_failure=raise_on_failure, snapshot_interval=snapshot_interval,
-                     trackers=trackers)
+    result = run_scene(load_scene(scene, overrides), progress=progress,
+                       raise_on_failure=raise_on_failure, snapshot_interval=snapshot_interval,
+                       trackers=trackers)
+    if stability:
+        import sys
+
+        from .simulation.stability import stderr_notice
+        from .simulation.stability_check import check
+
+        result.stability = check(result, notice=stderr_notice(progress or sys.stderr.isatty()))
+    return result
 
 
 def solve(scene, model: str | None = None, overrides=()):

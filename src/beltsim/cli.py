@@ -111,6 +111,8 @@ def cmd_run(args):
     from .io.files import prepare_outdir
     from .io.results import CHECKPOINT, SNAPSHOTS, save_run
     from .simulation.controller import Simulation
+    from .simulation.stability import Stability, stderr_notice
+    from .simulation.stability_check import check as check_stability
 
     if args.snapshots is not None and not args.snapshots > 0:
         raise UsageError(f"--snapshots: must be > 0 s, got {args.snapshots}")
@@ -137,6 +139,7 @@ def cmd_run(args):
               f"'beltsim run --resume {out}'", file=sys.stderr)
         return 130
     result.reference = sim.readout.reference()
+    result.stability = check_stability(result, notice=stderr_notice(_progress(args)))
     written = save_run(result, out)
     # an earlier run's snapshots would animate as this run's, its figures show as this one's
     _clear_stale(out, (SNAPSHOTS, *RUN_FIGURES), written=[p.name for p in written])
@@ -144,6 +147,8 @@ def cmd_run(args):
     print(format_summary(summary, title=title))
     print(format_run(summary))
     print(f"wrote {out}/summary.json, fields.csv, history.csv")
+    if isinstance(result.stability, Stability) and result.stability.warning():
+        print(f"beltsim: warning: {result.stability.warning()}", file=sys.stderr)
     if result.failed:
         print(f"beltsim: numerical failure: {result.reason}", file=sys.stderr)
         return 3

@@ -42,6 +42,9 @@ def format_run(summary: dict) -> str:
             if isinstance(part, dict):
                 lines.append(f"  last period     {key} min {part['min']:.6g}, mean "
                              f"{part['mean']:.6g}, max {part['max']:.6g}")
+    stab = summary.get("stability")
+    if stab:
+        lines.append(f"  stability       {stab['summary']}")
     err = summary.get("error")
     if err:
         parts = [f"{k} {v:.2e}" for k, v in err.items() if v is not None]

@@ -91,6 +91,7 @@ SCHEMA: dict[str, dict[str, Rule]] = {
         "newton_max_iterations": Rule("int", minimum=1),
         "snapshot_interval": POS,
         "gyroscopic": Rule("str", choices=("upwind", "central")),
+        "transient": Rule("str", choices=("fast", "physical")),
         "acceleration": Rule("float", nonneg=True),
         "max_work": POS,
     },

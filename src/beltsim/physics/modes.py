@@ -150,6 +150,8 @@ def steady_scene(scene):
     nm = data.get("numerics", {})
     for key in ("dt", "t_end", "time_tol", "max_work", "acceleration", "integrator"):
         nm.pop(key, None)
+    if nm.pop("transient", None) == "physical":  # its grid's form, without its step limit
+        nm["gyroscopic"] = "central"
     return type(scene).from_dict(data)
 
 

@@ -307,6 +307,10 @@ class NumericsSection(Section):
         The gyroscopic term's form: ``"upwind"`` (default; first order, damps the spans'
         modes numerically) or ``"central"`` (second order, no numerical damping;
         implicit schemes only).
+    transient : str, optional
+        ``"fast"`` (default: the quickest way to the steady state) or ``"physical"``
+        (the central form and a step limit from the spectrum, so that the scheme damps
+        the least stable mode by at most a tenth of its rate; esdirk3 or implicit).
     """
 
     section = "numerics"
@@ -327,6 +331,7 @@ class NumericsSection(Section):
     newton_max_iterations: int | None = None
     max_work: float | None = None
     gyroscopic: str | None = None
+    transient: str | None = None
 
 
 #: The section classes by their names in a scene file, in the file's order.

@@ -61,6 +61,7 @@ SCHEMA: dict[str, dict[str, Rule]] = {
         "newton_max_iterations": Rule("int", minimum=1),
         "max_work": POS,
         "gyroscopic": Rule("str", choices=("upwind", "central")),
+        "transient": Rule("str", choices=("fast", "physical")),
     },
 }
 
@@ -73,7 +74,8 @@ _ONLY_COULOMB = {("contact", "max_friction"), ("numerics", "regularisation")}
 _ONLY_STICK = {("numerics", "adhesion_layer")}
 # (physics.damping, like beam.density, describes the belt and is ignored without inertia)
 _ONLY_INERTIA = {("stiffness", "mass"), ("stiffness", "rotary_inertia"),
-                 ("numerics", "acceleration"), ("numerics", "gyroscopic")}
+                 ("numerics", "acceleration"), ("numerics", "gyroscopic"),
+                 ("numerics", "transient")}
 # Keys of required sections that may be left out (default in Params).
 _OPTIONAL_KEYS = {("physics", "damping")}
 

@@ -24,6 +24,7 @@ from ..problem.scene import Scene
 from .progress import ProgressTracker
 from .readout import readout_of
 from .result import RunResult, RunStatus
+from .stability import exact_least_stable, physical_step, stderr_notice
 from .trackers import (
     CallbackTracker,
     CheckpointTracker,
@@ -116,6 +117,10 @@ class Simulation:
             self.disc.loads = loads
         self.readout = readout_of(self.disc)
         self.scheme = solvers.get(self.disc.numerics.integrator)(self.disc)
+        if self.disc.numerics.transient == "physical":
+            self.scheme.max_step = physical_step(
+                exact_least_stable(scene, stderr_notice(sys.stderr.isatty())),
+                self.disc.numerics.integrator)
         self.state = self.disc.new_state()
         self._measured = self._solution = None
 

@@ -66,6 +66,10 @@ class RunResult:
         A periodic drive's last period: extremes and means of the history.
     reference : AnalyticSolution or None
         The exact steady solution of the scene, where :func:`beltsim.run` attached it.
+    stability : Stability, str or None
+        Whether the steady state is stable in the model
+        (:class:`beltsim.simulation.stability.Stability`), attached by :func:`beltsim.run`
+        and ``beltsim run`` to an inertial scene that settles.
 
     Examples
     --------
@@ -94,6 +98,10 @@ class RunResult:
     reference: analytic.AnalyticSolution | None = None
     #: what stopped a FAILED run (None for any other status)
     failure: FailureKind | None = None
+    #: whether the steady state is stable in the model, with the run's damping of its least
+    #: stable mode (:mod:`beltsim.simulation.stability`); a sentence where it could not be
+    #: computed; None where not checked (quasistatic, periodic, or the check off)
+    stability: object = None
 
     @property
     def converged(self) -> bool:
@@ -164,8 +172,9 @@ class RunResult:
             state, and ``converged``, ``simulated_time``, ``steps``, ``rejected_steps``,
             ``time_accurate``, ``wall_time``, ``compile_time``, ``reason``, ``failure``
             (a :class:`~beltsim.errors.FailureKind` value or None), ``elements``,
-            ``integrator``, ``power_balance``, ``periodic`` and ``error``
-            (:meth:`errors`).
+            ``integrator``, ``power_balance``, ``periodic``, ``error``
+            (:meth:`errors`) and ``stability`` (``Stability.to_dict()``, or
+            {"stable": None, "summary": why not checked}; None where it does not apply).
         """
         out = self.solution.summary()
         out.update(status=self.status.value, converged=self.converged,
@@ -178,8 +187,14 @@ class RunResult:
                    elements=self.numerics.elements,
                    integrator=self.numerics.integrator, power_balance=self.power_balance,
                    periodic=self.periodic,
-                   error=self.errors())
+                   error=self.errors(), stability=self._stability())
         return out
+
+    def _stability(self) -> dict | None:
+        if self.stability is None or isinstance(self.stability, str):
+            return (None if self.stability is None
+                    else {"stable": None, "summary": self.stability})
+        return self.stability.to_dict()
 
 
 def reference_of(scene: Scene, model: str | None = None):

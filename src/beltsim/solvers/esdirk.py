@@ -353,9 +353,10 @@ class EsdirkScheme(AdaptiveScheme):
                                  self.work, self.rates.au, self.rates.at)
             power_terms(state, t, d.mesh, d.model, d.drive, d.loads, self.power)
             self.started = True
+        h_max = min(t_stop - t, self.max_step) if t_stop > t else num.dt
         status, t, self.h_prev, self.h_next, steps, _ = advance_esdirk(
             state, self.rates, self.old, t, t_stop, self.h_prev, self.h_next, num.dt * 1e-7,
-            t_stop - t if t_stop > t else num.dt, num.time_tol, max_steps, d.mesh, d.model,
+            h_max, num.time_tol, max_steps, d.mesh, d.model,
             d.drive, d.loads, d.scales, self.settings, self.work, self.power, self.work_done)
         self.steps += steps
         self.check_status(status, t, self.h_next)

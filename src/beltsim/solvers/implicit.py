@@ -284,12 +284,18 @@ class AdaptiveScheme(NewtonScheme):
         super().__init__(disc)
         self.h_prev = 0.0  # no previous step
         self.h_next = self.numerics.dt
+        #: the longest step (s): a physical transient's limit (simulation.stability)
+        self.max_step = math.inf
         self.power = np.zeros(len(POWER_TERMS))  # at the current time
         self.work_done = np.zeros(len(POWER_TERMS))  # integrals since the start
 
     @property
     def dt(self) -> float:
         return self.h_next
+
+    def statistics(self) -> dict:
+        """The counters, and ``last_step``: the last step taken (s)."""
+        return super().statistics() | {"last_step": self.h_prev}
 
     def work_integrals(self) -> dict:
         """The time integrals (J) of the power terms since the start of the run."""
@@ -317,9 +323,10 @@ class ImplicitScheme(AdaptiveScheme):
 
     def advance(self, state, t, t_stop, max_steps=10**9):
         d, num = self.disc, self.numerics
+        h_max = min(t_stop - t, self.max_step) if t_stop > t else num.dt
         status, t, self.h_prev, self.h_next, steps, _ = advance_bdf2(
             state, self.hist, self.old, t, t_stop, self.h_prev, self.h_next, num.dt * 1e-7,
-            t_stop - t if t_stop > t else num.dt, num.time_tol, max_steps, d.mesh, d.model,
+            h_max, num.time_tol, max_steps, d.mesh, d.model,
             d.drive, d.loads, d.scales, self.settings, self.work, self.power, self.work_done)
         self.steps += steps
         self.check_status(status, t, self.h_next)

@@ -101,6 +101,8 @@ class Numerics:
     max_work: float = DEFAULT_MAX_WORK
     settle_time: float = 0.0  # when the drive stops changing (steady tests start there)
     gyroscopic: str = "upwind"  # the gyroscopic term's form (physics.discrete.GYROSCOPIC_FORMS)
+    #: "fast" or "physical" (the central form, and steps that resolve the least stable mode)
+    transient: str = "fast"
 
     @property
     def gyro_code(self) -> int:
@@ -168,7 +170,7 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         friction_scale = P.B / (P.c * delta)
     acceleration = acceleration_of(nm, integrator, P.inertia, math.pi * P.B / (
         P.L * math.sqrt(P.rho * P.b1)) if P.inertia else 0.0)
-    gyroscopic = nm.get("gyroscopic", "upwind")
+    transient, gyroscopic = transient_of(nm, integrator)
     if "max_work" in nm and integrator != "explicit":
         raise SceneError("numerics.max_work", 'only for numerics.integrator = "explicit" (the '
                          "other schemes' steps adapt)")
@@ -186,8 +188,35 @@ def resolve(scene: Scene, elements: int | None = None) -> Numerics:
         time_tol=nm.get("time_tol", TIME_TOLS.get(integrator, DEFAULT_TIME_TOL)),
         settle_time=settle_time(scene, ramp_time),
         max_work=nm.get("max_work", DEFAULT_MAX_WORK),
-        gyroscopic=gyroscopic,
+        gyroscopic=gyroscopic, transient=transient,
     )
+
+
+#: The schemes a physical transient takes: adaptive, implicit, with the central form
+PHYSICAL_SCHEMES = ("esdirk3", "implicit")
+
+
+def transient_of(nm: dict, integrator: str, closed: bool = False) -> tuple[str, str]:
+    """(numerics.transient, numerics.gyroscopic) with their defaults: a physical transient
+    takes the central form, and one of PHYSICAL_SCHEMES; a straight belt's only (its step
+    limit comes from the exact spectrum, which a closed drive does not have)."""
+    transient = nm.get("transient", "fast")
+    gyroscopic = nm.get("gyroscopic", "upwind")
+    if transient == "physical":
+        if closed:
+            raise SceneError("numerics.transient", '"physical" is for a straight belt: its '
+                             "step limit comes from the exact spectrum, and a drive has only "
+                             "the discrete one (beltsim modes)")
+        if "gyroscopic" in nm and gyroscopic != "central":
+            raise SceneError("numerics.gyroscopic", 'must be "central" with '
+                             'numerics.transient = "physical" (the upwind form damps the '
+                             "spans' modes)")
+        if integrator not in PHYSICAL_SCHEMES:
+            raise SceneError("numerics.transient", '"physical" needs numerics.integrator '
+                             f'= {" or ".join(repr(s) for s in PHYSICAL_SCHEMES)}, got '
+                             f"{integrator!r}")
+        gyroscopic = "central"
+    return transient, gyroscopic
 
 
 def acceleration_of(nm: dict, integrator: str, inertia: bool, omega1: float) -> float:
@@ -349,6 +378,7 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
     if "max_work" in nm and integrator != "explicit":
         raise SceneError("numerics.max_work", 'only for numerics.integrator = "explicit" (the '
                          "other schemes' steps adapt)")
+    transient, gyroscopic = transient_of(nm, integrator, closed=True)
     creep = creep_speed(P)
     # the lowest string frequency of the longer free span (pi sqrt(N0 / rho) / l)
     omega1 = math.pi * math.sqrt(P.N0 / P.rho) / max(P.layout.spans) \
@@ -373,4 +403,4 @@ def resolve_loop(scene, elements: int | None = None) -> Numerics:
         newton_max_iterations=newton_iterations(nm, law),
         time_tol=nm.get("time_tol", LOOP_TIME_TOLS.get(integrator, DEFAULT_TIME_TOL)),
         settle_time=settle, max_work=nm.get("max_work", DEFAULT_MAX_WORK),
-        gyroscopic=nm.get("gyroscopic", "upwind"))
+        gyroscopic=gyroscopic, transient=transient)
