@@ -56,6 +56,18 @@ def test_the_physical_step_bounds_the_steps_damping(integrator):
 
 
 @pytest.mark.unit
+def test_the_physical_step_resolves_every_growing_mode():
+    # the step is set by the mode it damps most: the highest growing frequency
+    low = st.Stability(rate=9.4, frequency=1303.0, method="exact", band=3000.0)
+    both = st.Stability(rate=9.4, frequency=1303.0, method="exact", band=3000.0,
+                        modes=((9.4, 1303.0), (8.8, 2879.0)))
+    high = st.Stability(rate=9.4, frequency=2879.0, method="exact", band=3000.0)
+    assert st.physical_step(both, "esdirk3") == pytest.approx(
+        st.physical_step(high, "esdirk3"), rel=1e-9)
+    assert st.physical_step(both, "esdirk3") < 0.5 * st.physical_step(low, "esdirk3")
+
+
+@pytest.mark.unit
 def test_verdicts_and_the_warning_text():
     grows = st.Stability(rate=9.39, frequency=1302.9, method="exact", band=3000.0,
                          growing=32, grid_damping=650.5, step_damping=-178.6)

@@ -43,7 +43,7 @@ BAND_HZ = 3000.0
 #: The environment variable that turns the check off ("0", "off", "no", "false")
 SWITCH = "BELTSIM_STABILITY"
 #: The cache entry's format; a change of it recomputes every entry
-FORMAT = 1
+FORMAT = 2
 
 
 @dataclass(frozen=True)
@@ -67,6 +67,10 @@ class Stability:
         The discrete estimate's error (1/s): its difference from the half grid's.
     growing : int
         How many roots in the band grow (exact), or 1 or 0 (discrete).
+    modes : tuple of (float, float)
+        (rate, frequency) of every growing root in the band, the least stable first; the
+        least stable alone when none grows. A physical transient resolves them all.
+        How many roots in the band grow (exact), or 1 or 0 (discrete).
     grid_damping, step_damping : float or None
         The run's numerical damping of that mode (1/s): its grid's (the exact rate minus
         the run's discrete eigenvalue's) and its time steps' (the discrete rate minus
@@ -81,8 +85,14 @@ class Stability:
     elements: int | None = None
     error: float | None = None
     growing: int = 0
+    modes: tuple = ()
     grid_damping: float | None = None
     step_damping: float | None = None
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Stability:
+        """The entry as :func:`dataclasses.asdict` wrote it (a cache's JSON)."""
+        return cls(**{**data, "modes": tuple(tuple(m) for m in data.get("modes", ()))})
 
     @property
     def unstable(self) -> bool:
@@ -175,15 +185,18 @@ def exact_least_stable(scene, notice=None) -> Stability:
     key = cache.key_of("stability", [FORMAT, "exact", physics_of(scene)])
     found = cache.load(key)
     if found is not None:
-        return Stability(**found)
+        return Stability.from_dict(found)
     if notice is not None:
         notice(NOTICE)
     roots = continuum.characteristic(scene).roots(BAND_HZ)
     if roots.size == 0:
         raise BeltsimError(f"no eigenvalue found up to {BAND_HZ:g} Hz")
     lam = roots[0]
+    growing = roots[roots.real > 0.0] if roots[0].real > 0.0 else roots[:1]
     out = Stability(rate=float(lam.real), frequency=float(lam.imag / (2 * math.pi)),
-                    method="exact", band=BAND_HZ, growing=int(np.sum(roots.real > 0.0)))
+                    method="exact", band=BAND_HZ, growing=int(np.sum(roots.real > 0.0)),
+                    modes=tuple((float(z.real), float(z.imag / (2 * math.pi)))
+                                for z in growing))
     cache.store(key, asdict(out))
     return out
 
@@ -229,11 +242,17 @@ def step_damping(integrator: str, lam: complex, h: float) -> float | None:
 
 
 def physical_step(found: Stability, integrator: str) -> float:
-    """The longest step (s) at which ``integrator`` damps (or amplifies) ``found``'s mode
-    by at most :data:`PHYSICAL_DAMPING` of its rate: the step limit of a physical
-    transient (``numerics.transient = "physical"``)."""
-    lam = complex(found.rate, 2 * math.pi * found.frequency)
+    """The longest step (s) at which ``integrator`` damps (or amplifies) each of
+    ``found.modes`` (the growing roots in the band) by at most :data:`PHYSICAL_DAMPING` of
+    the least stable rate: the step limit of a physical transient
+    (``numerics.transient = "physical"``)."""
     bound = PHYSICAL_DAMPING * max(abs(found.rate), 1.0)
+    modes = found.modes or ((found.rate, found.frequency),)
+    return min(_step_for(complex(r, 2 * math.pi * f), integrator, bound) for r, f in modes)
+
+
+def _step_for(lam: complex, integrator: str, bound: float) -> float:
+    """The longest step at which ``integrator`` damps the mode lam by at most ``bound``."""
     h = 1.0 / abs(lam)
     while abs(step_damping(integrator, lam, h)) > bound:  # the error falls as h^p
         h *= 0.5

@@ -57,7 +57,7 @@ def discrete_least_stable(scene, notice=None) -> Stability:
     key = cache.key_of("stability", [FORMAT, "discrete", physics_of(scene), _elements(scene)])
     found = cache.load(key)
     if found is not None:
-        return Stability(**found)
+        return Stability.from_dict(found)
     if notice is not None:
         notice(NOTICE)
     lam, n = _rightmost(scene)

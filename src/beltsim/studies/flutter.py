@@ -1,0 +1,189 @@
+"""The flutter of an unstable steady state: a physical transient
+(``numerics.transient = "physical"``) sampled finely enough to resolve its modes, its
+linear growth, and its limit cycle where it has one.
+
+A run records, at every sample (:data:`SAMPLES_PER_PERIOD` per period of the highest
+growing mode in the band), the total friction, the slip zone's start (or, for perfect
+adhesion, the concentrated force) and u at a probe in the outflow span. From these:
+
+* the growth rate of the linear phase: a straight line fitted to the logarithm of the
+  deviation's envelope (its largest |F - F_s| per window of :data:`WINDOW` s);
+* the limit cycle over the run's last :data:`WINDOW_CYCLE` s: half the peak-to-peak of
+  each record, the mean shift of the friction, the slip front's range and the leading
+  frequencies of the friction (Hann-windowed spectrum).
+
+Perfect adhesion has no bound on the friction, so its growth need not saturate; a run
+whose deviation passes :data:`NO_CYCLE` of the steady friction stops with that reason.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..simulation.controller import Simulation
+from ..simulation.trackers import Stop, Tracker
+
+#: Samples per period of the highest growing mode in the band
+SAMPLES_PER_PERIOD = 8
+#: The envelope's window (s): several periods of the slowest growing mode
+WINDOW = 0.02
+#: The limit cycle is measured over the run's last so many seconds
+WINDOW_CYCLE = 0.2
+#: A deviation of the total friction beyond this fraction of its steady value ends a run:
+#: past it no saturation is in sight, and the small-strain model is stretched
+NO_CYCLE = 1.0
+
+
+class FlutterLog(Tracker):
+    """Records, at every check, the total friction, the slip start (or concentrated
+    force) and u at ``probe`` (m); stops a run whose friction leaves the steady value by
+    more than :data:`NO_CYCLE` of it."""
+
+    def __init__(self, probe: float, steady_friction: float):
+        self.probe, self.steady = probe, steady_friction
+
+    def initialize(self, sim):
+        self.t, self.friction, self.front, self.u = [], [], [], []
+        x = sim.grid.x
+        self._j = int(np.clip(np.searchsorted(x, self.probe), 1, x.size - 1))
+        self._w = (self.probe - x[self._j - 1]) / (x[self._j] - x[self._j - 1])
+
+    def handle(self, sim):
+        sol = sim.solution()
+        summary = sol.summary()
+        front = summary.get("slip_start")
+        if front is None:
+            front = summary.get("concentrated_force")
+        u = sim.state.u
+        self.t.append(sim.t)
+        self.friction.append(sim.total_friction())
+        self.front.append(np.nan if front is None else front)
+        self.u.append((1 - self._w) * u[self._j - 1] + self._w * u[self._j])
+        if abs(self.friction[-1] - self.steady) > NO_CYCLE * abs(self.steady):
+            return Stop(reason=f"no limit cycle: the total friction left its steady value "
+                               f"by more than {NO_CYCLE:.0%} at t = {sim.t:.4g} s")
+        return None
+
+
+@dataclass
+class Flutter:
+    """A physical transient's records and how they were made."""
+
+    scene: object
+    elements: int
+    step: float  # the step limit (s)
+    steady_friction: float  # the exact steady state's (N)
+    t: np.ndarray
+    friction: np.ndarray
+    front: np.ndarray  # slip start (m) or concentrated force (N)
+    u: np.ndarray  # at the probe (m)
+    wall_time: float
+    steps: int
+    reason: str | None
+    extras: dict = field(default_factory=dict)
+
+    def deviation(self) -> np.ndarray:
+        """|F - F_s| / |F_s| at every sample."""
+        return np.abs(self.friction - self.steady_friction) / abs(self.steady_friction)
+
+    def envelope(self, window: float = WINDOW) -> tuple[np.ndarray, np.ndarray]:
+        """(window centres, largest deviation in each window)."""
+        edges = np.arange(self.t[0], self.t[-1] + 1e-12, window)
+        dev = self.deviation()
+        centres, peaks = [], []
+        for a in edges[:-1]:
+            m = (self.t >= a) & (self.t < a + window)
+            if m.any():
+                centres.append(a + 0.5 * window)
+                peaks.append(dev[m].max())
+        return np.array(centres), np.array(peaks)
+
+    def growth(self, t0: float, t1: float) -> float:
+        """The growth rate (1/s) of the envelope between t0 and t1: the slope of its
+        logarithm, fitted by least squares."""
+        c, p = self.envelope()
+        m = (c >= t0) & (c <= t1) & (p > 0)
+        if m.sum() < 3:
+            raise ValueError(f"growth: fewer than 3 windows between {t0} and {t1} s")
+        return float(np.polyfit(c[m], np.log(p[m]), 1)[0])
+
+    def limit_cycle(self, window: float = WINDOW_CYCLE) -> dict:
+        """Over the last ``window`` s: half the peak-to-peak of the friction (relative to
+        the steady value), of the front and of u at the probe; the friction's mean shift
+        (relative) and its three leading frequencies (Hz)."""
+        m = self.t >= self.t[-1] - window
+        F, t = self.friction[m], self.t[m]
+        half = lambda v: 0.5 * float(np.nanmax(v) - np.nanmin(v))  # noqa: E731
+        dt = float(np.median(np.diff(t)))
+        spec = np.abs(np.fft.rfft((F - F.mean()) * np.hanning(F.size)))
+        freqs = np.fft.rfftfreq(F.size, dt)
+        peaks = [i for i in range(1, spec.size - 1)
+                 if spec[i] >= spec[i - 1] and spec[i] >= spec[i + 1]]
+        peaks.sort(key=lambda i: -spec[i])
+        return {"friction": half(F) / abs(self.steady_friction),
+                "friction_mean": float(F.mean() / self.steady_friction - 1.0),
+                "front": half(self.front[m]),
+                "front_range": (float(np.nanmin(self.front[m])),
+                                float(np.nanmax(self.front[m]))),
+                "u": half(self.u[m]),
+                "frequencies": [float(freqs[i]) for i in peaks[:3]]}
+
+
+def flutter_run(scene, t_end: float, elements: int | None = None,
+                step_factor: float = 1.0, probe: float | None = None) -> Flutter:
+    """A physical transient of ``scene`` from rest to ``t_end`` (s), finely sampled.
+
+    Parameters
+    ----------
+    scene : Scene
+        An inertial straight-belt scene with an exact steady state.
+    t_end : float
+        Simulated seconds.
+    elements : int, optional
+        The grid (default the scene's).
+    step_factor : float, optional
+        The physical step limit times this (a time ladder: 1, 1/2, 1/4).
+    probe : float, optional
+        Where u is recorded (m); default the middle of the outflow span.
+
+    Returns
+    -------
+    Flutter
+    """
+    from ..problem import analytic
+    from ..simulation.stability import exact_least_stable
+
+    over = [("numerics.transient", "physical"), ("numerics.t_end", t_end),
+            ("numerics.steady_tol", 1e-300)]
+    if elements is not None:
+        over.append(("numerics.elements", elements))
+    sc = scene.with_overrides(over)
+    P = sc.params
+    found = exact_least_stable(sc)
+    f_top = max(f for _, f in (found.modes or ((found.rate, found.frequency),)))
+    sim = Simulation(sc)
+    sim.scheme.max_step *= step_factor
+    sim.check = 1.0 / (SAMPLES_PER_PERIOD * f_top)
+    exact = analytic.solve(sc)
+    log = FlutterLog(probe if probe is not None else 0.5 * (P.x2 + P.L),
+                     exact.summary()["total_friction"])
+    start = time.perf_counter()
+    res = sim.run(raise_on_failure=False, trackers=[log])
+    wall = time.perf_counter() - start
+    return Flutter(scene=sc, elements=sim.grid.n_elements, step=sim.scheme.max_step,
+                   steady_friction=log.steady, t=np.array(log.t),
+                   friction=np.array(log.friction), front=np.array(log.front),
+                   u=np.array(log.u), wall_time=wall, steps=res.steps,
+                   reason=res.reason, extras={"status": res.status.value,
+                                              "least_stable": found})
+
+
+def observed_order(a: float, b: float, c: float, ratio: float = 2.0) -> float:
+    """The observed order of a sequence a, b, c on grids refined by ``ratio``:
+    log(|a - b| / |b - c|) / log(ratio) (nan when b = c)."""
+    d1, d2 = abs(a - b), abs(b - c)
+    return math.log(d1 / d2) / math.log(ratio) if d2 > 0 and d1 > 0 else math.nan
