@@ -110,9 +110,8 @@ def cmd_run(args):
 
     from .io.files import prepare_outdir
     from .io.results import CHECKPOINT, SNAPSHOTS, save_run
+    from .simulation import stability_check
     from .simulation.controller import Simulation
-    from .simulation.stability import Stability, stderr_notice
-    from .simulation.stability_check import check as check_stability
 
     if args.snapshots is not None and not args.snapshots > 0:
         raise UsageError(f"--snapshots: must be > 0 s, got {args.snapshots}")
@@ -139,7 +138,7 @@ def cmd_run(args):
               f"'beltsim run --resume {out}'", file=sys.stderr)
         return 130
     result.reference = sim.readout.reference()
-    result.stability = check_stability(result, notice=stderr_notice(_progress(args)))
+    stability_check.attach(result, notice=_progress(args))
     written = save_run(result, out)
     # an earlier run's snapshots would animate as this run's, its figures show as this one's
     _clear_stale(out, (SNAPSHOTS, *RUN_FIGURES), written=[p.name for p in written])
@@ -147,8 +146,7 @@ def cmd_run(args):
     print(format_summary(summary, title=title))
     print(format_run(summary))
     print(f"wrote {out}/summary.json, fields.csv, history.csv")
-    if isinstance(result.stability, Stability) and result.stability.warning():
-        print(f"beltsim: warning: {result.stability.warning()}", file=sys.stderr)
+    stability_check.warn(result)
     if result.failed:
         print(f"beltsim: numerical failure: {result.reason}", file=sys.stderr)
         return 3
@@ -371,6 +369,7 @@ def cmd_animate(args):
     from .io.files import prepare_outdir
     from .io.results import SNAPSHOTS, save_run
     from .plots.animate import animate
+    from .simulation import stability_check
     from .simulation.controller import run
 
     if args.fps < 1:
@@ -402,12 +401,14 @@ def cmd_animate(args):
         out = prepare_outdir(args.out or Path("runs/out") / f"animate_{Path(args.scene).stem}")
         result = run(scene, progress=_progress(args), raise_on_failure=False,
                      snapshot_interval=interval)
+        stability_check.attach(result, notice=_progress(args))
         save_run(result, out)
         # a new run: the figures of an earlier one, the other format's animation among
         # them, go
         _clear_stale(out, RUN_FIGURES, written=(f"transient.{args.format}",))
         print(f"ran {args.scene}: {'steady' if result.converged else result.reason} at "
               f"t = {result.simulated_time:.4g} s, {len(result.snapshots['t'])} snapshots")
+        stability_check.warn(result)
         src = out
         if is_drive_scene(scene):
             return _drive_animate(args, out, src)

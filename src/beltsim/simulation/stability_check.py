@@ -149,3 +149,20 @@ def check(result, notice=None) -> Stability | str | None:
                             result.statistics.get("last_step"))
     except (BeltsimError, ArithmeticError, np.linalg.LinAlgError) as exc:
         return f"not checked: {exc}"
+
+
+def attach(result, notice: bool = False) -> None:
+    """Set ``result.stability`` (:func:`check`), printing a notice on stderr while a
+    scene's spectrum is computed when ``notice``."""
+    from .stability import stderr_notice
+
+    result.stability = check(result, notice=stderr_notice(notice))
+
+
+def warn(result) -> None:
+    """Print the one-line warning of a run whose steady state is unstable in the model
+    (on stderr, as ``beltsim: warning: ...``)."""
+    import sys
+
+    if isinstance(result.stability, Stability) and result.stability.warning():
+        print(f"beltsim: warning: {result.stability.warning()}", file=sys.stderr)
