@@ -10,8 +10,13 @@ time (sphinx-gallery); the API reference is generated from numpydoc docstrings
 generated from the code by ``_ext/beltsim_docs.py``.
 """
 
+import os
 import sys
 from pathlib import Path
+
+# the gallery's figures do not show the runs' stability check, which would add seconds per
+# scene to the build (beltsim.simulation.stability)
+os.environ.setdefault("BELTSIM_STABILITY", "0")
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE / "_ext"))

@@ -10,7 +10,7 @@ steady state:
 
 * a straight belt with an exact steady state: the exact roots of the continuous
   model's characteristic determinant (:mod:`beltsim.physics.continuum`, no grid) up to
-  :data:`BAND_HZ`; their chains run on above it with rates that do not decay, so the
+  ``BAND_HZ``; their chains run on above it with rates that do not decay, so the
   band is stated with the answer;
 * otherwise (closed drives; straight scenes without an exact state): the discrete
   model's rightmost eigenvalue with the central (second-order, non-dissipative)
@@ -91,7 +91,7 @@ class Stability:
 
     @classmethod
     def from_dict(cls, data: dict) -> Stability:
-        """The entry as :func:`dataclasses.asdict` wrote it (a cache's JSON)."""
+        """The entry as ``dataclasses.asdict`` wrote it (a cache's JSON)."""
         return cls(**{**data, "modes": tuple(tuple(m) for m in data.get("modes", ()))})
 
     @property
@@ -101,7 +101,8 @@ class Stability:
 
     @property
     def verdict(self) -> str:
-        """"unstable", "stable", or "undecided" (|rate| within the estimate's error)."""
+        """``"unstable"``, ``"stable"``, or ``"undecided"`` (the rate within the estimate's
+        error either way)."""
         if self.unstable:
             return "unstable"
         return "stable" if self.rate < -(self.error or 0.0) else "undecided"
@@ -147,7 +148,7 @@ class Stability:
 
 
 def enabled() -> bool:
-    """Whether runs check their steady state's stability (:data:`SWITCH`)."""
+    """Whether runs check their steady state's stability (``SWITCH``)."""
     return os.environ.get(SWITCH, "1").strip().lower() not in ("0", "off", "no", "false")
 
 
@@ -166,7 +167,7 @@ def physics_of(scene) -> dict:
 
 def exact_least_stable(scene, notice=None) -> Stability:
     """The least stable exact root of a straight-belt scene with an exact steady state
-    (:data:`BAND_HZ`), from the cache or computed (then cached).
+    (``BAND_HZ``), from the cache or computed (then cached).
 
     Parameters
     ----------
@@ -234,7 +235,7 @@ PHYSICAL_DAMPING = 0.1
 
 def step_damping(integrator: str, lam: complex, h: float) -> float | None:
     """The damping (1/s) of the mode exp(lambda t) by ``integrator``'s steps of h: the
-    exact rate minus ln|R(lambda h)| / h (None for a scheme without R)."""
+    exact rate minus ``ln(abs(R(lambda h))) / h`` (None for a scheme without R)."""
     R = amplification(integrator, lam * h)
     if R is None:
         return None
@@ -243,7 +244,7 @@ def step_damping(integrator: str, lam: complex, h: float) -> float | None:
 
 def physical_step(found: Stability, integrator: str) -> float:
     """The longest step (s) at which ``integrator`` damps (or amplifies) each of
-    ``found.modes`` (the growing roots in the band) by at most :data:`PHYSICAL_DAMPING` of
+    ``found.modes`` (the growing roots in the band) by at most ``PHYSICAL_DAMPING`` of
     the least stable rate: the step limit of a physical transient
     (``numerics.transient = "physical"``)."""
     bound = PHYSICAL_DAMPING * max(abs(found.rate), 1.0)
@@ -264,7 +265,7 @@ def _step_for(lam: complex, integrator: str, bound: float) -> float:
 
 
 def stderr_notice(show: bool):
-    """A ``notice`` for :func:`check` that prints to stderr, or None when ``show`` is
+    """A ``notice`` for :func:`~beltsim.simulation.stability_check.check` that prints to stderr, or None when ``show`` is
     false (nobody watches)."""
     if not show:
         return None

@@ -107,7 +107,7 @@ def with_damping(found: Stability, scene, integrator: str, step: float | None) -
 
     The grid's is the exact (or central) rate minus that of the run's own discrete model's
     eigenvalue nearest to the mode; the steps' is that eigenvalue's rate minus
-    ln|R(lambda h)| / h at the run's last step h
+    ``ln(abs(R(lambda h))) / h`` at the run's last step h
     (:func:`~beltsim.simulation.stability.step_damping`)."""
     if not found.unstable:
         return found
@@ -152,7 +152,7 @@ def check(result, notice=None) -> Stability | str | None:
 
 
 def attach(result, notice: bool = False) -> None:
-    """Set ``result.stability`` (:func:`check`), printing a notice on stderr while a
+    """Set ``result.stability`` (:func:`~beltsim.simulation.stability_check.check`), printing a notice on stderr while a
     scene's spectrum is computed when ``notice``."""
     from .stability import stderr_notice
 

@@ -2,18 +2,18 @@
 (``numerics.transient = "physical"``) sampled finely enough to resolve its modes, its
 linear growth, and its limit cycle where it has one.
 
-A run records, at every sample (:data:`SAMPLES_PER_PERIOD` per period of the highest
+A run records, at every sample (``SAMPLES_PER_PERIOD`` per period of the highest
 growing mode in the band), the total friction, the slip zone's start (or, for perfect
 adhesion, the concentrated force) and u at a probe in the outflow span. From these:
 
 * the growth rate of the linear phase: a straight line fitted to the logarithm of the
-  deviation's envelope (its largest |F - F_s| per window of :data:`WINDOW` s);
-* the limit cycle over the run's last :data:`WINDOW_CYCLE` s: half the peak-to-peak of
+  deviation's envelope (its largest ``abs(F - F_s)`` per window of ``WINDOW`` s);
+* the limit cycle over the run's last ``WINDOW_CYCLE`` s: half the peak-to-peak of
   each record, the mean shift of the friction, the slip front's range and the leading
   frequencies of the friction (Hann-windowed spectrum).
 
 Perfect adhesion has no bound on the friction, so its growth need not saturate; a run
-whose deviation passes :data:`NO_CYCLE` of the steady friction stops with that reason.
+whose deviation passes ``NO_CYCLE`` of the steady friction stops with that reason.
 """
 
 from __future__ import annotations
@@ -41,18 +41,21 @@ NO_CYCLE = 1.0
 class FlutterLog(Tracker):
     """Records, at every check, the total friction, the slip start (or concentrated
     force) and u at ``probe`` (m); stops a run whose friction leaves the steady value by
-    more than :data:`NO_CYCLE` of it."""
+    more than ``NO_CYCLE`` of it."""
 
     def __init__(self, probe: float, steady_friction: float):
         self.probe, self.steady = probe, steady_friction
 
     def initialize(self, sim):
+        """Empty records, and the probe's place on the grid."""
         self.t, self.friction, self.front, self.u = [], [], [], []
         x = sim.grid.x
         self._j = int(np.clip(np.searchsorted(x, self.probe), 1, x.size - 1))
         self._w = (self.probe - x[self._j - 1]) / (x[self._j] - x[self._j - 1])
 
     def handle(self, sim):
+        """Record this check; a stop once the friction leaves its steady value by more
+        than ``NO_CYCLE`` of it."""
         sol = sim.solution()
         summary = sol.summary()
         front = summary.get("slip_start")
@@ -87,7 +90,7 @@ class Flutter:
     extras: dict = field(default_factory=dict)
 
     def deviation(self) -> np.ndarray:
-        """|F - F_s| / |F_s| at every sample."""
+        """``abs(F - F_s) / abs(F_s)`` at every sample."""
         return np.abs(self.friction - self.steady_friction) / abs(self.steady_friction)
 
     def envelope(self, window: float = WINDOW) -> tuple[np.ndarray, np.ndarray]:
@@ -197,6 +200,6 @@ def flutter_run(scene, t_end: float, elements: int | None = None,
 
 def observed_order(a: float, b: float, c: float, ratio: float = 2.0) -> float:
     """The observed order of a sequence a, b, c on grids refined by ``ratio``:
-    log(|a - b| / |b - c|) / log(ratio) (nan when b = c)."""
+    ``log(abs(a - b) / abs(b - c)) / log(ratio)`` (nan when b = c)."""
     d1, d2 = abs(a - b), abs(b - c)
     return math.log(d1 / d2) / math.log(ratio) if d2 > 0 and d1 > 0 else math.nan
