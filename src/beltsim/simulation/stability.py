@@ -265,8 +265,8 @@ def _step_for(lam: complex, integrator: str, bound: float) -> float:
 
 
 def stderr_notice(show: bool):
-    """A ``notice`` for :func:`~beltsim.simulation.stability_check.check` that prints to stderr, or None when ``show`` is
-    false (nobody watches)."""
+    """A ``notice`` for :func:`~beltsim.simulation.stability_check.check` that prints to
+    stderr, or None when ``show`` is false (nobody watches)."""
     if not show:
         return None
     return lambda text: print(f"beltsim: {text}", file=sys.stderr, flush=True)

@@ -152,7 +152,7 @@ def check(result, notice=None) -> Stability | str | None:
 
 
 def attach(result, notice: bool = False) -> None:
-    """Set ``result.stability`` (:func:`~beltsim.simulation.stability_check.check`), printing a notice on stderr while a
+    """Set ``result.stability`` (:func:`check`), printing a notice on stderr while a
     scene's spectrum is computed when ``notice``."""
     from .stability import stderr_notice
 
