@@ -206,6 +206,63 @@ def test_model_converges_to_the_exact_beam_on_three_pulleys_with_a_back_side_idl
         assert -order > 1.8, (key, e)
         # within 3x of the measured errors (helpers.ERROR_FACTOR's margin)
         assert np.all(e <= 3.0 * np.array([MACHINE_ERRORS[n][key] for n in MACHINE_ERRORS]))
-    # the slip arcs' readout locates each front within its cell; its error falls at
-    # first order here (as on two pulleys): below a cell's share of the wrap
+    # the slip arcs' readout locates each front within its cell; on these cells, wider
+    # than the stick layer, the error scatters with the fronts' places in their cells
+    # (test_slip_front holds its order): below a cell's share of the wrap
     assert abs(errs[800]["slip_arc"]) < 2 * math.pi * 0.3 / 800
+
+
+def _slip_onset(scene, key, lo, hi, rtol):
+    """The load ``key`` at which the exact beam state gives way to gross slip, by
+    bisection on solve_beam's own answer (a state, or GrossSlipError)."""
+    from beltsim.beltdrive import GrossSlipError
+    from beltsim.beltdrive.beam import solve_beam
+
+    while hi - lo > rtol * hi:
+        mid = 0.5 * (lo + hi)
+        try:
+            solve_beam(scene.with_overrides({key: mid}).params)
+            lo = mid
+        except GrossSlipError:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+#: bisection's tolerance on the load; layout_capacity's root is to 1e-12
+ONSET_RTOL = 1e-6
+#: the beam's capacity against the creep theory's (its l -> 0 limit): measured 7.9e-6
+#: (the motor) and 2.2e-5 (the mill, the motor's mu at 0.6) relative on
+#: serpentine_machine, l / R = 0.019
+STRING_CAPACITY = 1e-4
+
+
+@pytest.mark.verification
+@pytest.mark.parametrize("motor_mu", [0.3, 0.6])
+def test_beam_capacity_on_n_pulleys_is_the_onset_of_gross_slip(motor_mu):
+    # serpentine_machine, its mill's load raised: at the scene's mu the motor slips
+    # first (its capacity in driver torque, every load raised together), with the
+    # motor's mu at 0.6 the mill (its own load)
+    from beltsim.beltdrive import GrossSlipError
+    from beltsim.beltdrive.beam import _defaults, layout_capacity, solve_beam
+    from beltsim.beltdrive.creep import serpentine_data, solve_serpentine
+
+    scene = _runs_scene("serpentine_machine",
+                        **{"pulley.motor.friction_coefficient": motor_mu})
+    P = scene.params
+    omega1 = _defaults(P, None, 0.0)[0]
+    motor, mill = P.layout.names.index("motor"), P.layout.names.index("mill")
+    i = motor if motor_mu == 0.3 else mill
+    cap = layout_capacity(P, omega1, i)
+    # in the mill's load: the driver's torque is r_motor M_mill / r_mill
+    ratio = P.layout.radii[mill] / P.layout.radii[motor] if i == motor else 1.0
+    onset = _slip_onset(scene, "pulley.mill.load_torque", 30.0, 80.0, ONSET_RTOL)
+    assert cap * ratio == pytest.approx(onset, rel=ONSET_RTOL)
+    # the gross-slip error names the pulley and carries its capacity
+    with pytest.raises(GrossSlipError, match=P.layout.names[i]) as err:
+        solve_beam(scene.with_overrides({"pulley.mill.load_torque": 80.0}).params)
+    assert err.value.capacity == pytest.approx(cap, rel=1e-9)
+    # the string limit: the creep theory's slip margin times the load it scales
+    string = solve_serpentine(serpentine_data(
+        scene.with_overrides({"physics.model": "string"}).params))
+    now = 30.0 / ratio
+    assert cap == pytest.approx(string.slip_margins[i] * now, rel=STRING_CAPACITY)

@@ -327,14 +327,20 @@ def test_a_straight_scene_reader_points_a_drive_to_load_scene():
     assert isinstance(beltsim.load_scene(scene_path("drive_flat")), DriveScene)
 
 
+#: the beam's slip arcs (over the wrap) times the elements squared, on 800 to 12800
+#: elements: measured up to 470 (the driver, 1.6e-4 on 1600). On this nested ladder the
+#: fronts' places in their cells double from grid to grid, which scatters single errors
+#: by two orders of magnitude (the driven pulley's 1.3e-6 on 1600, 8.2e-6 on 3200): an
+#: order fitted to them measures that scatter, the envelope does not
+SLIP_ENVELOPE = 700.0
+
+
 @pytest.mark.verification
 def test_steady_beam_converges_to_the_beams_exact_state():
     """The beam model against beltdrive.beam.solve_beam. Tensions and speed loss at second
-    order (measured 1.9 to 2.3 from 200 to 1600 elements). The slip arcs converge at
-    second order once the stick zone's boundary layer next to the front,
-    sqrt((A + B h^2 / 4) / b2) = 4.2 mm, is resolved: from the default grid (2.5 mm) up
-    (measured 1.5e-3 and 3.0e-4 of the wraps on 800 elements, 4.2e-5 and 1.4e-5 on
-    3200, 6.0e-6 and 3.3e-6 on 8000)."""
+    order (measured 1.9 to 2.3 from 200 to 1600 elements). The slip arcs within a
+    second-order envelope from 800 elements on (SLIP_ENVELOPE; test_slip_front holds the
+    envelope's order over grids that sample the fronts' places in their cells)."""
     from beltsim.beltdrive.beam import BeamSolution
     scene = flat()
     errs = {k: [] for k in ("tight_tension", "slack_tension", "speed_loss")}
@@ -353,10 +359,8 @@ def test_steady_beam_converges_to_the_beams_exact_state():
     ladder = (800, 1600, 3200, 6400, 12800)
     arcs = {k: [abs(solve_steady(scene, n).errors()[k]) for n in ladder]
             for k in ("slip_arc_driver", "slip_arc_driven")}
-    h = 1.0 / np.array(ladder)
     for k, e in arcs.items():
-        order = np.polyfit(np.log(h), np.log(e), 1)[0]
-        assert order >= 1.8, (k, e, order)
+        assert np.all(np.array(e) * np.array(ladder) ** 2 < SLIP_ENVELOPE), (k, e)
 
 
 @pytest.mark.verification

@@ -73,8 +73,8 @@ each of them F_i times minus the mean of the sliding speeds on its two sides,
 (c/2) F_i^2 (1/B + l^2/A).
 
 Capacity. Gross slip sets in when a slip arc covers its whole wrap; the beam's capacity is
-the load at which it does, solved for in the same model (:func:`capacity`), not the string's
-(the two differ by O(l)).
+the load at which it does, solved for in the same model (:func:`capacity`; on N pulleys
+each pulley's, :func:`layout_capacity`), not the string's (the two differ by O(l)).
 
 This module finds the steady state from its starts; the exact pieces and Newton's
 iteration are in :mod:`beltsim.beltdrive.beam_loop`, the solution's fields and summary in
@@ -90,7 +90,8 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import NoSolutionError
-from . import analytic
+from ..problem.roots import brentq
+from . import analytic, creep
 from .analytic import GrossSlipError, LiftOffError, solve_string
 from .beam_loop import (
     FLOOR_STEP,
@@ -342,31 +343,117 @@ def _margin(found) -> float:
     return n[1] / n[0]
 
 
-def _solve_layout(P: DriveParams, omega1: float):
-    """(loop, z, loads) of a drive on N pulleys, by Newton (backed by the continuation in
-    the lever) from the creep theory's state, which is exact at l = 0: its belt speed
-    and slip arcs, the idlers' slip arcs 0.
-
-    The creep theory's gross slip and lift-off are this drive's too (the capacities
-    differ by O(l), not searched for here); a beam slip arc beyond its wrap is gross
-    slip."""
-    data = replace(serpentine_data(replace(P, tensioner=None)), omega=omega1)
+def _layout_state(P: DriveParams, omega1: float, loads):
+    """(loop, z, d) of the beam on N pulleys at ``loads`` (N m per pulley, the driver's
+    0), by Newton (backed by the continuation in the lever) from the creep theory's state
+    at the same loads, which is exact at l = 0: its belt speed and slip arcs, the idlers'
+    slip arcs 0. The slip arcs d (m, signed) may pass their wraps: the capacity search
+    steps across them."""
+    data = replace(serpentine_data(replace(P, tensioner=None)), omega=omega1,
+                   loads=tuple(float(m) for m in loads))
     loads = np.array(data.loads)
-    s = solve_serpentine(data)
     mus = np.ones(len(loads)) if P.mu is None else np.asarray(P.mus)
-    mode, y0 = ("stick", (s.c,)) if P.mu is None else ("load", (s.c, *(mus * s.phi_s)))
+    if P.mu is None:
+        mode, y0 = "stick", (solve_serpentine(data).c,)
+    else:
+        c, _, _, phi = creep._solve_raw(data, data.layout, loads)
+        mode, y0 = "load", (c, *(mus * phi))
     try:
         loop, z, y = _converge(P, omega1, loads, mode, y0)
     except _NotConverged as exc:
         raise NoSolutionError(f"beam drive: no steady state found from the creep "
                               f"theory's ({exc})") from None
-    d = _unpack(P, mode, y, loads)[1]
+    return loop, z, _unpack(P, mode, y, loads)[1]
+
+
+def layout_capacity(P: DriveParams, omega1: float, i: int) -> float:
+    """The load (N m) at which pulley i's slip arc covers its whole wrap on N pulleys:
+    its own load raised with the others' held or, for the driver, every load raised
+    together (its torque then), as the creep theory's slip margins
+    (:func:`beltsim.beltdrive.creep` ``slip_margins``); other pulleys' slip arcs are not
+    limited.
+
+    A root in the load factor of the beam's slip arc less the wrap, bracketed from the
+    creep theory's factor (the two differ by O(l)) outwards by steps of 1 % doubling. As
+    in the creep theory, a state lost first (lift-off) caps the factor where it is lost.
+
+    Raises
+    ------
+    NoSolutionError
+        No bracket: the beam's state is lost (lift-off, Newton) before the slip arc
+        reaches its wrap.
+    """
+    lay = P.layout
+    data = replace(serpentine_data(replace(P, tensioner=None)), omega=omega1)
+    base = np.asarray(data.loads, dtype=float)
+    scale_all = i == P.driver
+
+    def loads_at(lam):
+        if scale_all:
+            return base * lam
+        out = base.copy()
+        out[i] *= lam
+        return out
+
+    def excess(lam):  # the slip arc's share of the wrap, less 1; inf where no state
+        try:
+            d = _layout_state(P, omega1, loads_at(lam))[2]
+        except NoSolutionError:
+            return math.inf
+        return abs(d[i]) / lay.arcs[i] - 1.0
+
+    lam0 = creep._load_factor(data, lay, i, scale_all)
+    lo = hi = lam0
+    step = 0.01
+    while excess(lo) >= 0.0:
+        hi, lo, step = lo, lo * (1.0 - step), min(2.0 * step, 0.5)
+        if lo < 1e-6 * lam0:
+            raise NoSolutionError(f"pulley {lay.names[i]!r}: no beam capacity found")
+    step, e_hi = 0.01, excess(hi)
+    while e_hi < 0.0:
+        if hi > 1e6 * lam0:
+            raise NoSolutionError(f"pulley {lay.names[i]!r}: no beam capacity found")
+        lo, hi, step = hi, hi * (1.0 + step), 2.0 * step
+        e_hi = excess(hi)
+    lam = brentq(lambda m: min(excess(m), 1e3), lo, hi, xtol=1e-12 * hi, rtol=1e-12)
+    now = lay.radii[i] * float(np.sum(base / lay.radii)) if scale_all else base[i]
+    return float(lam * now)
+
+
+def _solve_layout(P: DriveParams, omega1: float):
+    """(loop, z, loads) of a drive on N pulleys (:func:`_layout_state`).
+
+    The creep theory's lift-off is this drive's too; a beam slip arc beyond its wrap is
+    gross slip (or, where Newton is lost, a creep theory's one), with the capacity of the
+    pulley whose slip arc passes its wrap the most (:func:`layout_capacity`)."""
+    data = replace(serpentine_data(replace(P, tensioner=None)), omega=omega1)
+    loads = np.array(data.loads)
+    try:
+        loop, z, d = _layout_state(P, omega1, loads)
+    except LiftOffError:
+        raise
+    except NoSolutionError:
+        # Newton lost beyond a wrap: the creep theory's overloaded pulley is the one
+        phi = creep._solve_raw(data, data.layout, loads)[3]
+        if P.mu is None or not np.any(phi > P.layout.wraps):
+            raise
+        loop = z = None
+        d = phi * P.layout.radii
     if d is not None and not _fits(P, d):
         i = int(np.argmax(np.abs(d) / P.layout.arcs))
-        raise GrossSlipError(f"pulley {P.layout.names[i]!r}: the beam's slip arc "
-                             f"{abs(d[i]) / P.layout.radii[i]:.4g} rad exceeds its wrap "
-                             f"{P.layout.wraps[i]:.4g} rad (gross slip: no steady state)",
-                             math.nan)
+        try:
+            cap = layout_capacity(P, omega1, i)
+        except NoSolutionError:
+            cap = math.nan
+        if i == P.driver:
+            now = P.layout.radii[i] * float(np.sum(loads / P.layout.radii))
+            what = "driver torque"
+        else:
+            now, what = loads[i], "load"
+        raise GrossSlipError(f"pulley {P.layout.names[i]!r}: {what} {now:.6g} N m exceeds "
+                             f"its beam capacity {cap:.6g} N m (gross slip: slip arc "
+                             f"{abs(d[i]) / P.layout.radii[i]:.4g} rad > wrap "
+                             f"{P.layout.wraps[i]:.4g} rad)", cap)
     return loop, z, loads
 
 
@@ -383,7 +470,8 @@ def solve_beam(P: DriveParams, omega1: float | None = None,
     ------
     GrossSlipError
         The load exceeds the beam drive's capacity
-        (:func:`beltsim.beltdrive.beam.capacity`, in the message; NaN on N pulleys).
+        (:func:`beltsim.beltdrive.beam.capacity`, in the message; on N pulleys the
+        overloaded pulley's, :func:`layout_capacity`).
     LiftOffError
         The contact pressure does not stay positive on the arcs.
     NoSolutionError
@@ -464,5 +552,5 @@ def slip_collapse(P: DriveParams, mus, omega1: float | None = None,
 
 
 __all__ = ["FLOOR_STEP", "MAX_DAMPED", "MAX_ITERATIONS", "STEP_TOL", "BeamSolution",
-           "capacity", "slip_collapse", "solve_beam"]
+           "capacity", "layout_capacity", "slip_collapse", "solve_beam"]
 

@@ -39,6 +39,85 @@ LOOP_ERROR_KEYS = ("span_tension", "speed_loss", "slip_arc", "hub_load", "belt_s
                    "driver_torque")
 
 
+def stick_rate(alpha: float, h: float) -> float:
+    """The growth rate (1/m) of the discrete stick mode on cells of length h: the grid's
+    stick zone grows by r = exp(kappa h) from node to node, r + 1/r = 2 + (alpha h)^2
+    (theta's central second difference), so kappa = (2 / h) asinh(alpha h / 2), alpha
+    to O(alpha^3 h^2) and below alpha on cells wider than the layer 1/alpha."""
+    return 2.0 / h * math.asinh(0.5 * alpha * h) if alpha > 0 else 0.0
+
+
+def stick_mode(kappa: float, d, values) -> tuple[float, float, float]:
+    """(kappa, P, Q): the stick zone's ratio P exp(kappa s) + Q exp(-kappa s) (s from the
+    node in front) through ``values`` at the offsets ``d`` (two, upstream, < 0); a
+    straight line through them where kappa is 0 (no lever: the string)."""
+    (d1, d2), (v1, v2) = d, values
+    if kappa == 0.0:
+        slope = (v1 - v2) / (d1 - d2)
+        return 0.0, v1 - slope * d1, slope
+    M = np.array([[math.exp(kappa * d1), math.exp(-kappa * d1)],
+                  [math.exp(kappa * d2), math.exp(-kappa * d2)]])
+    P, Q = np.linalg.solve(M, [v1, v2])
+    return kappa, float(P), float(Q)
+
+
+def _stick_integral(stick, lo: float, s: float) -> float:
+    """The integral of the stick mode (:func:`stick_mode`) over [lo, s]."""
+    kappa, P, Q = stick
+    if kappa == 0.0:
+        return P * (s - lo) + 0.5 * Q * (s * s - lo * lo)
+    return (P * (math.exp(kappa * s) - math.exp(kappa * lo))
+            - Q * (math.exp(-kappa * s) - math.exp(-kappa * lo))) / kappa
+
+
+def _value(stick, s: float) -> float:
+    """The stick mode (:func:`stick_mode`) at s."""
+    kappa, P, Q = stick
+    if kappa == 0.0:
+        return P + Q * s
+    return P * math.exp(kappa * s) + Q * math.exp(-kappa * s)
+
+
+def _bisect(fun, a: float, b: float) -> float:
+    """The root of fun on [a, b] (fun(a), fun(b) of opposite signs), to round-off."""
+    fa = fun(a)
+    for _ in range(60):
+        mid = 0.5 * (a + b)
+        fm = fun(mid)
+        if (fm > 0.0) == (fa > 0.0):
+            a, fa = mid, fm
+        else:
+            b = mid
+    return 0.5 * (a + b)
+
+
+def front_in_volume(stick, total: float, sign: float, lo: float, hi: float) -> float:
+    """Where in the volume [lo, hi] (about its node) the slip arc starts: the s at which
+    the stick ratio's integral over [lo, s] plus ``sign`` (hi - s) is ``total`` (the
+    node's ratio times its volume), clamped to the volume.
+
+    The stick ratio is the stick mode (:func:`stick_mode`) up to where it would reach
+    the Coulomb bound ``sign``, which a sticking point cannot pass: on cells wider than
+    the layer the grid's mode grows many times over a cell (a mode at the bound where
+    the volume begins carries no stick share). Below the bound the residual falls
+    monotonically, so bisection finds its one root.
+    """
+    cut = hi
+    if sign * _value(stick, lo) >= 1.0:  # a mode at the bound already: no stick share
+        stick = (0.0, 0.0, 0.0)
+    elif sign * _value(stick, hi) > 1.0:  # the mode reaches the bound inside the volume
+        cut = _bisect(lambda s: sign * _value(stick, s) - 1.0, lo, hi)
+
+    def excess(s):
+        s = min(s, cut)
+        return _stick_integral(stick, lo, s) + sign * (hi - s) - total
+
+    ea, eb = excess(lo), excess(cut)
+    if ea * eb >= 0.0:  # no front inside (or at an end): the end nearer a root
+        return lo if abs(ea) <= abs(eb) else cut
+    return _bisect(excess, lo, cut)
+
+
 def history_keys(P) -> tuple[str, ...]:
     """What a history records at every check: the two-pulley keys for a two-pulley
     drive, else the driver's speed, LOOP_KEYS,
@@ -142,20 +221,28 @@ class LoopSolution:
                                         - stretch[first[2 * i + 1]]) / spans[i]
                          for i in range(len(spans))])
 
-    def slip_arcs(self) -> tuple[float, float]:
+    def slip_arcs(self) -> tuple[float, ...]:
         """The slip arc of each pulley (rad): the sliding nodes' contact lengths plus the
-        sliding share of the last sticking node next to them.
+        sliding share of the last sticking node in front of them.
 
-        A node's friction is the integral of f over its volume. With the front inside the
-        volume of the last sticking node j, a share phi of it slides (ratio +-1) and the
-        rest sticks with the stick zone's ratio lam_s, so lam_j = (1 - phi) lam_s + phi
-        sign: phi = (lam_j - lam_s) / (sign - lam_s), with lam_s extrapolated linearly
-        from the two sticking nodes upstream (zero for the string, whose stick zones carry
-        no friction). The front is then located within a cell, not at its nodes.
+        A node's friction is the integral of f over its volume. With the front x* inside
+        the volume [a, b] of the last sticking node j, its ratio is lam_j (b - a) = (the
+        integral of the stick zone's ratio over [a, x*]) + sign (b - x*), solved for x*
+        (:func:`front_in_volume`). The stick zone's ratio is the beam's stick mode: the
+        two exponentials of theta'' = alpha^2 theta (f = B l theta'' in stick) through
+        the two sticking nodes upstream, at the grid's own rate (:func:`stick_rate`).
+        The stick layer is about 1/alpha wide (3 mm on the shipped drives: a few cells
+        or a fraction of one), and a straight line through those nodes would miss its
+        growth across node j's volume by about (alpha h)^2 of the ratio (0.1 of a cell
+        at alpha h = 0.36). The string's stick zones carry no friction.
         """
-        m, f = self.mesh, self._fields
+        m, f, P = self.mesh, self._fields, self.params
         lam, slide = f["ratio"], f["slip"]
         N = len(self.x)
+        x, he = self.x, m.he
+        lever = P.lever
+        B, A = P.b1 - P.rho * self.c**2, P.a - P.I * self.c**2
+        alpha = math.sqrt(P.b2 / (A + lever * lever * B)) if lever > 0 and A > 0 else 0.0
         out = []
         for a in range(len(m.seg_radius)):
             js = np.flatnonzero(m.seg == a)
@@ -165,12 +252,17 @@ class LoopSolution:
                     continue  # not the sticking node in front of a sliding run
                 sign = math.copysign(1.0, lam[(j + 1) % N])
                 j1, j2 = (j - 1) % N, (j - 2) % N
-                lam_s = 0.0
+                hi = 0.5 * he[j]
+                lo = hi - m.wf[j]  # node j's volume about x_j
                 if m.seg[j1] == a and m.seg[j2] == a and not (slide[j1] or slide[j2]):
-                    lam_s = 2.0 * lam[j1] - lam[j2]
-                if sign != lam_s:
-                    phi = min(1.0, max(0.0, (lam[j] - lam_s) / (sign - lam_s)))
-                    length += m.wf[j] * phi
+                    d1 = -((x[j] - x[j1]) % m.loop_length)
+                    d2 = d1 - (x[j1] - x[j2]) % m.loop_length
+                    stick = stick_mode(stick_rate(alpha, he[j1]), (d1, d2),
+                                       (lam[j1], lam[j2]))
+                else:
+                    stick = (0.0, 0.0, 0.0)
+                start = front_in_volume(stick, lam[j] * (hi - lo), sign, lo, hi)
+                length += hi - start
             out.append(length / m.seg_radius[a])
         return out
 
