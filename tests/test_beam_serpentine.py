@@ -237,6 +237,7 @@ STRING_CAPACITY = 1e-4
 
 
 @pytest.mark.verification
+@pytest.mark.long  # 10 to 20 s each on a quiet machine: CI's budget
 @pytest.mark.parametrize("motor_mu", [0.3, 0.6])
 def test_beam_capacity_on_n_pulleys_is_the_onset_of_gross_slip(motor_mu):
     # serpentine_machine, its mill's load raised: at the scene's mu the motor slips
