@@ -20,7 +20,7 @@ from beltsim.problem import analytic
 from beltsim.simulation.stability import BAND_HZ
 from beltsim.studies import stability_map as study
 
-from .kit import Page, decorate, fmt
+from .kit import Page, decorate, fmt, num
 
 TITLE = "A stability map of the paper's steady states"
 SCENES = ("paper_slip", "paper_inertia")
@@ -154,7 +154,7 @@ def friction_section(page: Page, cfg: dict) -> list:
         "steady state's slip start x* and its stick zone [x1, x*] (x1 = L/3; full slip, no "
         "stick zone, where x* = x1). Perfect adhesion (paper_inertia) has no f*. Command: "
         "`beltsim stability-map paper_slip --param max_friction --values "
-        + ",".join(f"{f:g}" for f in cfg["frictions"]) + "`.")
+        + ",".join(num(f) for f in cfg["frictions"]) + "`.")
     scene = shipped_scene("paper_slip")
     swept = study.sweep(scene, "max_friction", cfg["frictions"])
     rows = []
@@ -166,10 +166,16 @@ def friction_section(page: Page, cfg: dict) -> list:
             stick = f"{sol.x_star - scene.params.x1:.4f}"
         except NoSolutionError:
             xs = stick = ""
-        rows.append([f"{row['value']:g}", xs, stick, *cells(page, row)])
+        rows.append([num(row["value"]), xs, stick, *cells(page, row)])
+        row["stick"] = None if not stick else float(stick)
     page.table(["f* [N/m]", "slip start x* [m]", "stick zone [m]", "rate [1/s]",
                 "at [Hz]", "growing"], rows)
-    page.para(f"Cost: {computed(swept)}.")
+    stable = [num(r["value"]) for r in swept if r["status"] == study.STABLE]
+    stuck = [r for r in swept if r["stick"]]
+    page.para(f"Cost: {computed(swept)}. No root grows at f* = "
+              f"{', '.join(stable) or 'none of these'}; with a stick zone the state is "
+              f"unstable at {sum(r['status'] == study.UNSTABLE for r in stuck)} of "
+              f"{len(stuck)} values.")
     return swept
 
 
@@ -198,8 +204,14 @@ def speed_section(page: Page, cfg: dict) -> dict:
         rows.append(line)
     page.table(header, rows)
     page.para("Cost: " + "; ".join(f"{name} {computed(r)}" for name, r in sweeps.items())
-              + ".")
+              + ". No root grows at " + "; ".join(
+                  f"{name}: " + stable_speeds(rows) for name, rows in sweeps.items()) + ".")
     return sweeps
+
+
+def stable_speeds(rows) -> str:
+    speeds = [f"{r['value']:g}" for r in rows if r["status"] == study.STABLE]
+    return f"c = {', '.join(speeds)} m/s" if speeds else "none of these speeds"
 
 
 def figure(page: Page, sweeps: dict, crit: dict) -> None:
