@@ -10,7 +10,7 @@ steady state:
 
 * a straight belt with an exact steady state: the exact roots of the continuous
   model's characteristic determinant (:mod:`beltsim.physics.continuum`, no grid) up to
-  :data:`BAND_HZ`; their chains run on above it with rates that do not decay, so the
+  ``BAND_HZ``; their chains run on above it with rates that do not decay, so the
   band is stated with the answer;
 * otherwise (closed drives; straight scenes without an exact state): the discrete
   model's rightmost eigenvalue with the central (second-order, non-dissipative)
@@ -91,7 +91,8 @@ class Stability:
 
     @property
     def verdict(self) -> str:
-        """"unstable", "stable", or "undecided" (|rate| within the estimate's error)."""
+        """"unstable", "stable", or "undecided" (the rate's magnitude within the estimate's
+        error)."""
         if self.unstable:
             return "unstable"
         return "stable" if self.rate < -(self.error or 0.0) else "undecided"
@@ -137,7 +138,7 @@ class Stability:
 
 
 def enabled() -> bool:
-    """Whether runs check their steady state's stability (:data:`SWITCH`)."""
+    """Whether runs check their steady state's stability (``SWITCH``)."""
     return os.environ.get(SWITCH, "1").strip().lower() not in ("0", "off", "no", "false")
 
 
@@ -156,7 +157,7 @@ def physics_of(scene) -> dict:
 
 def exact_least_stable(scene, notice=None) -> Stability:
     """The least stable exact root of a straight-belt scene with an exact steady state
-    (:data:`BAND_HZ`), from the cache or computed (then cached).
+    (``BAND_HZ``), from the cache or computed (then cached).
 
     Parameters
     ----------
@@ -230,7 +231,7 @@ def step_damping(integrator: str, lam: complex, h: float) -> float | None:
 
 def physical_step(found: Stability, integrator: str) -> float:
     """The longest step (s) at which ``integrator`` damps (or amplifies) ``found``'s mode
-    by at most :data:`PHYSICAL_DAMPING` of its rate: the step limit of a physical
+    by at most ``PHYSICAL_DAMPING`` of its rate: the step limit of a physical
     transient (``numerics.transient = "physical"``)."""
     lam = complex(found.rate, 2 * math.pi * found.frequency)
     bound = PHYSICAL_DAMPING * max(abs(found.rate), 1.0)
@@ -245,8 +246,8 @@ def physical_step(found: Stability, integrator: str) -> float:
 
 
 def stderr_notice(show: bool):
-    """A ``notice`` for :func:`check` that prints to stderr, or None when ``show`` is
-    false (nobody watches)."""
+    """A ``notice`` for :func:`~beltsim.simulation.stability_check.check` that prints to
+    stderr, or None when ``show`` is false (nobody watches)."""
     if not show:
         return None
     return lambda text: print(f"beltsim: {text}", file=sys.stderr, flush=True)

@@ -2,10 +2,10 @@
 one parameter, and the damping a stable steady state needs.
 
 Each point is the least stable root of the continuous model linearised about the exact
-steady state, up to :data:`~beltsim.simulation.stability.BAND_HZ`
+steady state, up to ``BAND_HZ`` of :mod:`beltsim.simulation.stability`
 (:func:`~beltsim.simulation.stability.exact_least_stable`, cached per scene: seconds
 when computed, milliseconds when cached). No run and no grid is involved. The
-parameters (:data:`PARAMS`):
+parameters (``PARAMS``):
 
 ``damping``
     d (1/s), ``physics.damping``; the steady state does not depend on it, only its
@@ -68,7 +68,7 @@ def check_scene(scene, param: str) -> None:
     scene : Scene
         The scene to map.
     param : str
-        One of :data:`PARAMS`.
+        One of ``PARAMS``.
 
     Raises
     ------
@@ -107,7 +107,7 @@ def overrides(scene, param: str, value: float) -> list:
     scene : Scene
         The scene mapped.
     param : str
-        One of :data:`PARAMS`.
+        One of ``PARAMS``.
     value : float
         The parameter's value.
 
@@ -132,7 +132,7 @@ def check_values(scene, param: str, values) -> list[float]:
     scene : Scene
         The scene mapped.
     param : str
-        One of :data:`PARAMS`.
+        One of ``PARAMS``.
     values : iterable of float
         The parameter's values.
 
@@ -159,15 +159,15 @@ def point(scene, param: str, value: float) -> dict:
     scene : Scene
         A straight belt that :func:`check_scene` accepts.
     param : str
-        One of :data:`PARAMS`.
+        One of ``PARAMS``.
     value : float
         The parameter's value.
 
     Returns
     -------
     dict
-        ``value``; ``status`` (:data:`UNSTABLE`, :data:`STABLE`,
-        :data:`NO_STEADY_STATE` or :data:`NO_ROOT`); ``rate`` (1/s), ``frequency``
+        ``value``; ``status`` (``UNSTABLE``, ``STABLE``,
+        ``NO_STEADY_STATE`` or ``NO_ROOT``); ``rate`` (1/s), ``frequency``
         (Hz) and ``growing`` (how many roots in the band grow), each None unless a root
         was found; ``reason`` (why there is none, else empty); ``cached`` (whether the
         root came from the cache) and ``wall_time`` (s).
@@ -205,7 +205,7 @@ def sweep(scene, param: str, values, progress=None) -> list[dict]:
     scene : Scene
         A straight belt that :func:`check_scene` accepts.
     param : str
-        One of :data:`PARAMS`.
+        One of ``PARAMS``.
     values : iterable of float
         The parameter's values.
     progress : callable, optional
@@ -291,9 +291,9 @@ def critical_damping(scene, tol: float = TOLERANCE, max_damping: float = MAX_DAM
     scene : Scene
         An inertial straight belt with a constant or tabulated (not sine) drive.
     tol : float, optional
-        The bracket's final width (1/s in d); default :data:`TOLERANCE`.
+        The bracket's final width (1/s in d); default ``TOLERANCE``.
     max_damping : float, optional
-        The largest d tried (1/s); default :data:`MAX_DAMPING`.
+        The largest d tried (1/s); default ``MAX_DAMPING``.
     progress : callable, optional
         ``progress(row)`` after each root search (:func:`point`).
 
@@ -360,14 +360,14 @@ def critical_damping(scene, tol: float = TOLERANCE, max_damping: float = MAX_DAM
     return CriticalDamping(hi, lo, tol, evaluations)
 
 
-#: The columns of a map's CSV, in order (text columns: :data:`TEXT_COLUMNS`)
+#: The columns of a map's CSV, in order (text columns: ``TEXT_COLUMNS``)
 COLUMNS = ("value", "status", "rate", "frequency", "growing", "cached", "wall_time",
            "reason")
 TEXT_COLUMNS = ("status", "reason")
 
 
 def csv_columns(rows) -> list:
-    """The rows as the columns of :data:`COLUMNS` (None as NaN, booleans as 0 or 1), for
+    """The rows as the columns of ``COLUMNS`` (None as NaN, booleans as 0 or 1), for
     :func:`beltsim.io.files.write_csv`.
 
     Parameters
