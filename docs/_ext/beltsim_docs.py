@@ -216,6 +216,9 @@ class BeltsimCli(SphinxDirective):
         if rows:
             lines += ["| argument | default | meaning |", "|---|---|---|", *rows]
         self.env.note_dependency(build_parser.__code__.co_filename)
+        func = parser.get_default("func")  # a command registered from its own module
+        if func is not None:
+            self.env.note_dependency(func.__code__.co_filename)
         _shown(self.env, "commands").add(name)
         node = nodes.container(classes=["beltsim-cli"])
         self.state.nested_parse(StringList(lines, self.get_source_info()[0]),

@@ -576,6 +576,8 @@ def build_parser():
                    help="time each run this many times and keep the shortest (default 3)")
     p.add_argument("--no-cold", action="store_true", help="skip the cold-start run")
     p.set_defaults(func=cmd_bench)
+    from .cli_map import add_parser as add_stability_map  # beltsim stability-map
+    add_stability_map(sub, _add_scene_args)
     return parser
 
 

@@ -75,3 +75,33 @@ def cell(v):
     if isinstance(v, int):
         return f"{v:>12d}"
     return f"{v:>12.4g}"
+
+
+def float_list(text, name):
+    """Comma-separated finite numbers (``--values``)."""
+    import math
+
+    try:
+        vals = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise UsageError(f"{name}: expected comma-separated numbers, got {text!r}") from None
+    if not vals or not all(math.isfinite(v) for v in vals):
+        raise UsageError(f"{name}: expected comma-separated finite numbers, got {text!r}")
+    return vals
+
+
+def map_header(param: str, unit: str) -> str:
+    """The header of ``beltsim stability-map``'s table."""
+    return (f"{param + ' [' + unit + ']':>22s}  {'status':<15s}  {'rate [1/s]':>11s}  "
+            f"{'frequency [Hz]':>14s}  {'growing':>7s}  {'wall [s]':>8s}")
+
+
+def map_row(row: dict) -> str:
+    """One point of a stability map as a line of its table (a point without a root: its
+    status and why)."""
+    head = f"{row['value']:>22.6g}  {row['status']:<15s}  "
+    wall = f"{row['wall_time']:>8.3g}" + (" (cached)" if row["cached"] else "")
+    if row["rate"] is None:
+        return head + f"{'':>11s}  {'':>14s}  {'':>7s}  {wall}  {row['reason']}"
+    return (head + f"{row['rate']:>+11.4g}  {row['frequency']:>14.6g}  "
+            f"{row['growing']:>7d}  {wall}")

@@ -58,6 +58,7 @@ def _pages():
         serpentine,
         spectrum,
         stability,
+        stability_map,
     )
 
     return (("paper", paper.TITLE, paper.build),
@@ -65,6 +66,7 @@ def _pages():
             ("convergence", convergence.TITLE, convergence.build),
             ("paths", paths.TITLE, paths.build),
             ("spectrum", spectrum.TITLE, spectrum.build),
+            ("stability_map", stability_map.TITLE, stability_map.build),
             ("stability", stability.TITLE, stability.build),
             ("balance", balance.TITLE, balance.build),
             ("drive", drive.TITLE, drive.build),

@@ -51,6 +51,8 @@ SOURCES = {
                                      "validation/pages/convergence.py"),
     "verification/paths.md": (*ENGINE, "validation/pages/paths.py"),
     "verification/spectrum.md": (*ENGINE, "validation/pages/spectrum.py"),
+    "verification/stability_map.md": (*ENGINE, "src/beltsim/studies/stability_map.py",
+                                       "validation/pages/stability_map.py"),
     "verification/stability.md": (*ENGINE, "src/beltsim/studies/stability.py",
                                    "validation/pages/stability.py"),
     "verification/balance.md": (*ENGINE, "validation/pages/balance.py"),
