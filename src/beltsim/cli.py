@@ -447,26 +447,18 @@ def cmd_modes(args):
 
 def cmd_scenes(args):
     from .api import scene_names, shipped_scene
+    from .cli_text import scene_kind
     from .errors import MissingInputError
 
     names = scene_names()
     if not names:
         raise MissingInputError("no scenes ship with this installation of beltsim")
-    rows = [(name, *_scene_kind(shipped_scene(name))) for name in names]
+    rows = [(name, *scene_kind(shipped_scene(name))) for name in names]
     width = max(len(name) for name, *_ in rows)
     kind_width = max(len(kind) for _, kind, _ in rows)
     for name, kind, title in rows:
         print(f"{name:<{width}}  {kind:<{kind_width}}  {title}")
     return 0
-
-
-def _scene_kind(scene) -> tuple[str, str]:
-    """A shipped scene's kind (closed drive or straight belt, and its friction) and title."""
-    if is_drive_scene(scene):
-        return "closed drive", scene.title
-    friction = {"stick": "perfect adhesion", "coulomb": "stick and slip"}
-    return f"straight belt, {friction.get(scene.contact.friction, scene.contact.friction)}", \
-        scene.title
 
 
 def build_parser():

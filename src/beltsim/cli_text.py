@@ -105,3 +105,15 @@ def map_row(row: dict) -> str:
         return head + f"{'':>11s}  {'':>14s}  {'':>7s}  {wall}  {row['reason']}"
     return (head + f"{row['rate']:>+11.4g}  {row['frequency']:>14.6g}  "
             f"{row['growing']:>7d}  {wall}")
+
+
+def scene_kind(scene) -> tuple[str, str]:
+    """A shipped scene's kind (closed drive or straight belt, and its friction) and title
+    (``beltsim scenes``)."""
+    from .problem.kinds import is_drive_scene
+
+    if is_drive_scene(scene):
+        return "closed drive", scene.title
+    friction = {"stick": "perfect adhesion", "coulomb": "stick and slip"}
+    return f"straight belt, {friction.get(scene.contact.friction, scene.contact.friction)}", \
+        scene.title

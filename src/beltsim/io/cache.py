@@ -2,7 +2,7 @@
 data: the stability check's spectra (:mod:`beltsim.simulation.stability`).
 
 Entries are JSON files named by a hash of what they depend on and of the package's
-version, under ``$BELTSIM_CACHE_DIR``, else ``$XDG_CACHE_HOME/beltsim``, else
+version and sources, under ``$BELTSIM_CACHE_DIR``, else ``$XDG_CACHE_HOME/beltsim``, else
 ``~/.cache/beltsim``. A cache that cannot be read or written is skipped: the value is
 computed again, never taken from a damaged file.
 """
@@ -26,13 +26,24 @@ def cache_dir() -> Path:
     return Path(base) / "beltsim"
 
 
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
+_SOURCES: list[str] = []
 
-    try:
-        return version("beltsim")
-    except PackageNotFoundError:  # a source tree on sys.path, not installed
-        return "source"
+
+def _version() -> str:
+    """The package's version and a hash of its sources: an entry computed by other code
+    (a source checkout between two edits, another install) is not served."""
+    if not _SOURCES:
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            ver = version("beltsim")
+        except PackageNotFoundError:  # a source tree on sys.path, not installed
+            ver = "source"
+        digest = hashlib.sha256()
+        for path in sorted(Path(__file__).resolve().parents[1].rglob("*.py")):
+            digest.update(path.read_bytes())
+        _SOURCES.append(f"{ver}+{digest.hexdigest()[:16]}")
+    return _SOURCES[0]
 
 
 def key_of(kind: str, data) -> str:
