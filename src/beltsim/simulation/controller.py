@@ -24,7 +24,7 @@ from ..problem.scene import Scene
 from .progress import ProgressTracker
 from .readout import readout_of
 from .result import RunResult, RunStatus
-from .stability import exact_least_stable, physical_step, stderr_notice
+from .stability import exact_least_stable, physical_sampling, physical_step, stderr_notice
 from .trackers import (
     CallbackTracker,
     CheckpointTracker,
@@ -86,7 +86,7 @@ class Simulation:
         num = self.numerics
         window = self.disc.window
         self.snapshot_interval = snapshot_interval or num.snapshot_interval
-        self.check = window / CHECKS_PER_TRANSIT
+        self.check = min(window / CHECKS_PER_TRANSIT, self._sampling)
         if self.snapshot_interval:
             self.check = min(self.check, self.snapshot_interval)
         self.history = HistoryTracker(self.readout.history_keys)
@@ -117,10 +117,11 @@ class Simulation:
             self.disc.loads = loads
         self.readout = readout_of(self.disc)
         self.scheme = solvers.get(self.disc.numerics.integrator)(self.disc)
+        self._sampling = math.inf  # a physical transient's checks resolve its modes
         if self.disc.numerics.transient == "physical":
-            self.scheme.max_step = physical_step(
-                exact_least_stable(scene, stderr_notice(sys.stderr.isatty())),
-                self.disc.numerics.integrator)
+            found = exact_least_stable(scene, stderr_notice(sys.stderr.isatty()))
+            self.scheme.max_step = physical_step(found, self.disc.numerics.integrator)
+            self._sampling = physical_sampling(found)
         self.state = self.disc.new_state()
         self._measured = self._solution = None
 

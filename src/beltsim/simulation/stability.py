@@ -252,6 +252,18 @@ def physical_step(found: Stability, integrator: str) -> float:
     return min(_step_for(complex(r, 2 * math.pi * f), integrator, bound) for r, f in modes)
 
 
+#: A physical transient's checks (its history's rows) per period of the highest growing
+#: root of the band
+SAMPLES_PER_PERIOD = 8
+
+
+def physical_sampling(found: Stability) -> float:
+    """A physical transient's check interval (s): ``SAMPLES_PER_PERIOD`` checks per period
+    of the highest growing root in ``found.modes``, so that its history resolves them."""
+    modes = found.modes or ((found.rate, found.frequency),)
+    return 1.0 / (SAMPLES_PER_PERIOD * max(f for _, f in modes))
+
+
 def _step_for(lam: complex, integrator: str, bound: float) -> float:
     """The longest step at which ``integrator`` damps the mode lam by at most ``bound``."""
     h = 1.0 / abs(lam)

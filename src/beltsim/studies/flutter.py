@@ -2,8 +2,9 @@
 (``numerics.transient = "physical"``) sampled finely enough to resolve its modes, its
 linear growth, and its limit cycle where it has one.
 
-A run records, at every sample (``SAMPLES_PER_PERIOD`` per period of the highest
-growing mode in the band), the total friction, the slip zone's start (or, for perfect
+A run records, at every check (a physical transient's are
+:func:`~beltsim.simulation.stability.physical_sampling` apart: 8 per period of the
+highest growing root in the band), the total friction, the slip zone's start (or, for perfect
 adhesion, the concentrated force) and u at a probe in the outflow span. From these:
 
 * the growth rate of the linear phase: a straight line fitted to the logarithm of the
@@ -27,8 +28,6 @@ import numpy as np
 from ..simulation.controller import Simulation
 from ..simulation.trackers import Stop, Tracker
 
-#: Samples per period of the highest growing mode in the band
-SAMPLES_PER_PERIOD = 8
 #: The envelope's window (s): several periods of the slowest growing mode
 WINDOW = 0.02
 #: The limit cycle is measured over the run's last so many seconds
@@ -163,7 +162,6 @@ def flutter_run(scene, t_end: float, elements: int | None = None,
     Flutter
     """
     from ..physics.modes import steady_discretisation
-    from ..simulation.stability import exact_least_stable
 
     over = [("numerics.transient", "physical"), ("numerics.t_end", t_end),
             ("numerics.steady_tol", 1e-300)]
@@ -173,11 +171,8 @@ def flutter_run(scene, t_end: float, elements: int | None = None,
         over.append(("numerics.ramp_time", 0.0))
     sc = scene.with_overrides(over)
     P = sc.params
-    found = exact_least_stable(sc)
-    f_top = max(f for _, f in (found.modes or ((found.rate, found.frequency),)))
     sim = Simulation(sc)
     sim.scheme.max_step *= step_factor
-    sim.check = 1.0 / (SAMPLES_PER_PERIOD * f_top)
     # the deviation is measured from the grid's own steady state, not the exact one: the
     # discretisation's error in it would otherwise floor the linear phase
     steady = steady_discretisation(sc, sim.grid.n_elements)[1]
@@ -194,8 +189,7 @@ def flutter_run(scene, t_end: float, elements: int | None = None,
                    steady_friction=log.steady, t=np.array(log.t),
                    friction=np.array(log.friction), front=np.array(log.front),
                    u=np.array(log.u), wall_time=wall, steps=res.steps,
-                   reason=res.reason, extras={"status": res.status.value,
-                                              "least_stable": found})
+                   reason=res.reason, extras={"status": res.status.value})
 
 
 def observed_order(a: float, b: float, c: float, ratio: float = 2.0) -> float:
