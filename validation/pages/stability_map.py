@@ -33,9 +33,8 @@ CFG = {False: {"scenes": SCENES, "dampings": study.DEFAULT_VALUES["damping"],
 
 @contextlib.contextmanager
 def fresh_cache():
-    """Every root computed by this run: the user's cache is keyed by the scene's data and
-    the package's version, not by the code, so a source checkout could serve roots that an
-    older version of the code computed."""
+    """Every root computed by this run, so that the page's wall times are the searches'
+    (the user's cache would serve the roots an earlier run computed)."""
     old = os.environ.get("BELTSIM_CACHE_DIR")
     with tempfile.TemporaryDirectory(prefix="beltsim_map_") as folder:
         os.environ["BELTSIM_CACHE_DIR"] = folder

@@ -53,6 +53,8 @@ SOURCES = {
     "verification/spectrum.md": (*ENGINE, "validation/pages/spectrum.py"),
     "verification/stability_map.md": (*ENGINE, "src/beltsim/studies/stability_map.py",
                                        "validation/pages/stability_map.py"),
+    "verification/flutter.md": (*ENGINE, "src/beltsim/studies/flutter.py",
+                                "validation/pages/spectrum.py", "validation/pages/flutter.py"),
     "verification/stability.md": (*ENGINE, "src/beltsim/studies/stability.py",
                                    "validation/pages/stability.py"),
     "verification/balance.md": (*ENGINE, "validation/pages/balance.py"),
