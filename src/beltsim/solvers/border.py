@@ -35,9 +35,8 @@ class Border(NamedTuple):
     X: np.ndarray  # A^{-1} Bm (nb, n_int, b)
     Sinv: np.ndarray  # the Schur complement's inverse (nb, nb)
     rb: np.ndarray  # the border's right-hand side (nb)
-    # each border column's first band row that is not zero, and each global row's
-    # band rows [lo, hi) that are not: a free pulley couples to its arc's rows only
-    first: np.ndarray  # (nb)
+    # each global's band rows [lo, hi) whose entries are not zero: a free pulley
+    # couples to its arc's rows only
     span: np.ndarray  # (ng, 2)
 
     @classmethod
@@ -46,15 +45,14 @@ class Border(NamedTuple):
         nb, ni = 2 * b + n_globals, max(n_rows - 2, 0)
         return cls(np.zeros((nb, ni, b)), np.zeros((nb, ni, b)), np.zeros((nb, nb)),
                    np.zeros((nb, ni, b)), np.zeros((nb, nb)), np.zeros(nb),
-                   np.zeros(nb, np.int64), np.zeros((n_globals, 2), np.int64))
+                   np.zeros((n_globals, 2), np.int64))
 
 
 @njit(cache=True, no_cpython_wrapper=True)
 def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
     """Fill bd's Bm, Cm, Dm from a loop's wrapped band (rows 0..n-1, each coupling to
     nodes i-2, i-1, i, i+1 modulo n) and its global blocks Gc (n, b, ng), Gr (ng, n, b),
-    Gd (ng, ng), with each column's first row and each global row's span that are not
-    zero (bd.first, bd.span)."""
+    Gd (ng, ng), with the span of each global's rows that are not zero (bd.span)."""
     n, b = Db.shape[0], Db.shape[1]
     ni = n - 2
     ng = Gd.shape[0]
@@ -84,8 +82,6 @@ def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
             bd.Dm[a, b + q] = Ub[n - 2, a, q]
             bd.Dm[b + a, q] = Lb[n - 1, a, q]
             bd.Dm[b + a, b + q] = Db[n - 1, a, q]
-    for q in range(2 * b):
-        bd.first[q] = 0
     for k in range(ng):
         lo, hi = ni, 0
         for i in range(ni):
@@ -97,7 +93,6 @@ def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
             if nonzero:
                 lo = min(lo, i)
                 hi = i + 1
-        bd.first[2 * b + k] = lo
         bd.span[k, 0], bd.span[k, 1] = lo, hi
         for a in range(b):
             bd.Dm[a, 2 * b + k] = Gc[n - 2, a, k]
@@ -109,13 +104,12 @@ def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
 
 
 @njit(cache=True, no_cpython_wrapper=True)
-def block_substitute_many(w, r, x, first):
+def block_substitute_many(w, r, x):
     """:func:`beltsim.solvers.newton.block_substitute` for each right-hand side r[q]
     (m, n, 2) into x[q], the same arithmetic in the same order: the columns interleave,
     each row's factors loaded once for all of them, and the columns' recurrences (each a
     chain of dependent steps) overlap. For the border's columns (w: a Newton
-    workspace with the band's factors); r[q] is zero above its row first[q], where the
-    forward sweep stays zero and is skipped."""
+    workspace with the band's factors)."""
     C, W, Ub, W2 = w.C, w.W, w.U, w.W2
     m, n = r.shape[0], r.shape[1]
     for i in range(n):
@@ -127,9 +121,6 @@ def block_substitute_many(w, r, x, first):
         if i > 1:
             v00, v01, v10, v11 = W2[i, 0, 0], W2[i, 0, 1], W2[i, 1, 0], W2[i, 1, 1]
             for q in range(m):
-                if i <= first[q]:
-                    x[q, i, 0], x[q, i, 1] = r[q, i, 0], r[q, i, 1]
-                    continue
                 y0, y1 = x[q, i - 1, 0], x[q, i - 1, 1]
                 z0 = r[q, i, 0] - w00 * y0 - w01 * y1
                 z1 = r[q, i, 1] - w10 * y0 - w11 * y1
@@ -184,14 +175,12 @@ def schur(bd):
     for r in range(2 * b):  # the border nodes' rows: three band rows each
         for q in range(nb):
             S[r, q] -= border_row_dot(bd, r, bd.X[q])
-    for k in range(nb - 2 * b):  # the globals' rows, over their spans
-        r = 2 * b + k
-        for q in range(nb):
-            acc = 0.0
-            for i in range(bd.span[k, 0], bd.span[k, 1]):
-                for a in range(b):
-                    acc += bd.Cm[r, i, a] * bd.X[q, i, a]
-            S[r, q] -= acc
+    for k in range(nb - 2 * b):  # the globals' rows, over their spans (BLAS)
+        lo, hi = bd.span[k, 0] * b, bd.span[k, 1] * b
+        if hi > lo:
+            row = bd.Cm[2 * b + k].reshape(ni * b)[lo:hi]
+            for q in range(nb):
+                S[2 * b + k, q] -= np.dot(row, bd.X[q].reshape(ni * b)[lo:hi])
     # scale rows and columns to unit diagonal-ish size: the border mixes metres, N and 1/s
     d = np.ones(nb)
     for r in range(nb):
@@ -228,17 +217,17 @@ def finish(bd, r, rg, x, dg):
         bd.rb[2 * b + k] = rg[k]
     for q in range(2 * b):
         bd.rb[q] -= border_row_dot(bd, q, x)
-    for k in range(nb - 2 * b):  # the globals' rows, over their spans
-        acc = 0.0
-        for i in range(bd.span[k, 0], bd.span[k, 1]):
-            for a in range(b):
-                acc += bd.Cm[2 * b + k, i, a] * x[i, a]
-        bd.rb[2 * b + k] -= acc
+    xf = x[:ni].reshape(ni * b)  # the band's rows, flat: contiguous loops vectorise
+    for k in range(nb - 2 * b):  # the globals' rows, over their spans (BLAS)
+        lo, hi = bd.span[k, 0] * b, bd.span[k, 1] * b
+        if hi > lo:
+            bd.rb[2 * b + k] -= np.dot(bd.Cm[2 * b + k].reshape(ni * b)[lo:hi], xf[lo:hi])
     z = bd.Sinv @ bd.rb
     for q in range(nb):
-        for i in range(ni):
-            for a in range(b):
-                x[i, a] -= bd.X[q, i, a] * z[q]
+        Xq = bd.X[q].reshape(ni * b)
+        zq = z[q]
+        for i in range(ni * b):
+            xf[i] -= Xq[i] * zq
     for a in range(b):
         x[n - 2, a] = z[a]
         x[n - 1, a] = z[b + a]

@@ -242,7 +242,7 @@ def factorise_bordered(w, bd):
     if not block_factor(w.Lb[:ni], w.Db[:ni], w.Ub[:ni], w):
         return False
     gather(w.Lb, w.L2, w.Db, w.Ub, w.Gc, w.Gr, w.Gd, bd)
-    block_substitute_many(w, bd.Bm, bd.X, bd.first)
+    block_substitute_many(w, bd.Bm, bd.X)
     return schur(bd)
 
 
