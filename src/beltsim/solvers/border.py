@@ -168,6 +168,39 @@ def border_row_dot(bd, r, y):
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def invert(A, out):
+    """out = A^{-1} by Gauss-Jordan elimination with partial pivoting (A is overwritten);
+    False at a zero pivot. For the border's small matrix (some ten rows), where LAPACK's
+    calls (a determinant to test, then the inverse) cost more than the arithmetic."""
+    n = A.shape[0]
+    for i in range(n):
+        for j in range(n):
+            out[i, j] = 1.0 if i == j else 0.0
+    for k in range(n):
+        p, big = k, abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > big:
+                p, big = i, abs(A[i, k])
+        if not big > 0.0:  # zero (singular) or NaN
+            return False
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+                out[k, j], out[p, j] = out[p, j], out[k, j]
+        f = 1.0 / A[k, k]
+        for j in range(n):
+            A[k, j] *= f
+            out[k, j] *= f
+        for i in range(n):
+            if i != k and A[i, k] != 0.0:
+                m = A[i, k]
+                for j in range(n):
+                    A[i, j] -= m * A[k, j]
+                    out[i, j] -= m * out[k, j]
+    return True
+
+
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def schur(bd):
     """bd.Sinv from bd.X = A^{-1} Bm; False when the complement is singular."""
     nb, ni, b = bd.X.shape
@@ -192,9 +225,9 @@ def schur(bd):
     Sd = S * d.reshape(nb, 1)
     if not np.all(np.isfinite(Sd)):
         return False
-    if abs(np.linalg.det(Sd)) == 0.0:
+    if not invert(Sd, bd.Sinv):
         return False
-    bd.Sinv[:, :] = np.linalg.inv(Sd) * d.reshape(1, nb)
+    bd.Sinv[:, :] = bd.Sinv * d.reshape(1, nb)
     return np.all(np.isfinite(bd.Sinv))
 
 
