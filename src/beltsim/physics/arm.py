@@ -172,6 +172,8 @@ def stencil_stretch(mesh, g) -> np.ndarray:
     """What the stretch adds to the three-point strain stencil ``mesh.sw`` at each node:
     sw_2 h_{j-1} e_{j-1} + (sw_1 + sw_2) h_{j-2} e_{j-2} (the stencil reads the
     differences of u over elements j - 1 and j - 2)."""
+    if mesh.arm_idx.shape[0] == 0:  # no arm: zeros, without the rolls (read every check)
+        return np.zeros(len(mesh.he))
     e = element_stretches(mesh, g)
     sw, he = mesh.sw, mesh.he
     e1, h1 = np.roll(e, 1), np.roll(he, 1)

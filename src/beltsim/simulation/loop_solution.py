@@ -128,6 +128,29 @@ def history_keys(P) -> tuple[str, ...]:
     return ("t", "omega1", *LOOP_KEYS, *figure_keys(P.layout.names), *arm, *POWER_KEYS)
 
 
+class _Indices:
+    """What every reading of a loop's state on one mesh indexes with: the strain
+    stencil's nodes, the contact nodes with their radii and each arc's nodes (a run reads
+    its state at every check; these depend on the mesh alone)."""
+
+    def __init__(self, mesh):
+        N = len(mesh.seg)
+        self.stencil = (np.arange(N)[:, None] + np.arange(-2, 1)[None, :]) % N
+        self.on = mesh.seg >= 0
+        self.radius = np.where(self.on, mesh.seg_radius[np.maximum(mesh.seg, 0)], 1.0)
+        self.arcs = [np.flatnonzero(mesh.seg == a) for a in range(len(mesh.seg_radius))]
+
+
+def indices_of(disc) -> _Indices:
+    """The :class:`_Indices` of a discretisation's mesh, made at its first reading."""
+    ix = disc.__dict__.get("_loop_indices")
+    if ix is None or ix.mesh is not disc.mesh:
+        ix = _Indices(disc.mesh)
+        ix.mesh = disc.mesh
+        disc._loop_indices = ix
+    return ix
+
+
 class LoopSolution:
     """A loop's state at time t read as the drive's solution.
 
@@ -168,20 +191,21 @@ class LoopSolution:
         #: each pulley's speed (rad/s): the driver's prescribed, the others' unknowns
         self.speeds = np.array([self.rim1 / rd if k < 0 else float(state.g[k])
                                 for k in disc.speed_global])
+        self._ix = indices_of(disc)
+        self._torques = None
         self._fields = self._read(disc.model)
 
     def _read(self, prm) -> dict:
-        P, m, s = self.params, self.mesh, self.state
+        P, m, s, ix = self.params, self.mesh, self.state, self._ix
         N = len(self.x)
-        idx = (np.arange(N)[:, None] + np.arange(-2, 1)[None, :]) % N
+        idx = ix.stencil
         lever = prm.half_height * m.face  # the face in contact's (per node)
         # axial force: the upwind three-point strain (the friction's) at every node
         stretch = stencil_stretch(m, s.g)  # a tensioner's spans' (physics.arm)
         eps = np.sum(m.sw * s.u[idx], axis=1) + stretch
         epsb = np.sum(m.sw * (s.u[idx] + lever[:, None] * s.theta[idx]), axis=1) + stretch
         tension = P.N0 + P.b1 * eps
-        on = m.seg >= 0
-        R = np.where(on, m.seg_radius[np.maximum(m.seg, 0)], 1.0)
+        on, R = ix.on, ix.radius
         p = np.where(on, (tension - P.rho * self.c**2) / R, 0.0)
         f = traction(s.fnode, m.wf)
         rim = np.where(on, self.speeds[np.maximum(m.seg, 0)] * R, 0.0)
@@ -244,8 +268,7 @@ class LoopSolution:
         B, A = P.b1 - P.rho * self.c**2, P.a - P.I * self.c**2
         alpha = math.sqrt(P.b2 / (A + lever * lever * B)) if lever > 0 and A > 0 else 0.0
         out = []
-        for a in range(len(m.seg_radius)):
-            js = np.flatnonzero(m.seg == a)
+        for a, js in enumerate(self._ix.arcs):
             length = float(np.sum(m.wf[js][slide[js]]))
             for j in (js[slide[js]] - 1) % N:
                 if m.seg[j] != a or slide[j]:
@@ -270,10 +293,12 @@ class LoopSolution:
         """The torque (N m) the driver puts into the belt and each other pulley takes out
         of it: r times the friction on its arc, signed so that both are positive in a
         driving drive."""
-        F, m = self.state.fnode, self.mesh
-        return np.array([(1.0 if k < 0 else -1.0) * m.seg_radius[a]
-                         * float(np.sum(F[m.seg == a]))
-                         for a, k in enumerate(self.disc.speed_global)])
+        if self._torques is None:
+            F, m, arcs = self.state.fnode, self.mesh, self._ix.arcs
+            self._torques = np.array([(1.0 if k < 0 else -1.0) * m.seg_radius[a]
+                                      * float(np.sum(F[arcs[a]]))
+                                      for a, k in enumerate(self.disc.speed_global)])
+        return self._torques.copy()
 
     def driver_torque(self) -> float:
         """The driver's torque: r_d (the friction on its arc) (N m)."""
@@ -415,7 +440,7 @@ class LoopSolution:
         """The name of a pulley whose whole wrap slides, or None."""
         slide = self._fields["slip"]
         for a, p in enumerate(self.params.pulleys):
-            if np.all(slide[self.mesh.seg == a]):
+            if np.all(slide[self._ix.arcs[a]]):
                 return p.name
         return None
 

@@ -35,26 +35,35 @@ class Border(NamedTuple):
     X: np.ndarray  # A^{-1} Bm (nb, n_int, b)
     Sinv: np.ndarray  # the Schur complement's inverse (nb, nb)
     rb: np.ndarray  # the border's right-hand side (nb)
+    # each global's band rows [lo, hi) whose entries are not zero: a free pulley
+    # couples to its arc's rows only
+    span: np.ndarray  # (ng, 2)
 
     @classmethod
     def allocate(cls, n_rows: int, b: int, n_globals: int) -> Border:
         """The arrays for a loop of ``n_rows`` nodes, blocks of ``b``, ``n_globals``."""
         nb, ni = 2 * b + n_globals, max(n_rows - 2, 0)
         return cls(np.zeros((nb, ni, b)), np.zeros((nb, ni, b)), np.zeros((nb, nb)),
-                   np.zeros((nb, ni, b)), np.zeros((nb, nb)), np.zeros(nb))
+                   np.zeros((nb, ni, b)), np.zeros((nb, nb)), np.zeros(nb),
+                   np.zeros((n_globals, 2), np.int64))
 
 
 @njit(cache=True, no_cpython_wrapper=True)
 def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
     """Fill bd's Bm, Cm, Dm from a loop's wrapped band (rows 0..n-1, each coupling to
     nodes i-2, i-1, i, i+1 modulo n) and its global blocks Gc (n, b, ng), Gr (ng, n, b),
-    Gd (ng, ng)."""
+    Gd (ng, ng), with the span of each global's rows that are not zero (bd.span)."""
     n, b = Db.shape[0], Db.shape[1]
     ni = n - 2
     ng = Gd.shape[0]
-    bd.Bm[:, :, :] = 0.0
-    bd.Cm[:, :, :] = 0.0
-    bd.Dm[:, :] = 0.0
+    # the border nodes' columns and rows reach the band's rows 0, 1, ni - 2 and ni - 1
+    # only (below), and the globals' are copied whole: no other entry is ever set
+    for i in (0, 1, ni - 2, ni - 1):
+        if 0 <= i < ni:
+            for q in range(2 * b):
+                for a in range(b):
+                    bd.Bm[q, i, a] = 0.0
+                    bd.Cm[q, i, a] = 0.0
     for a in range(b):
         for q in range(b):
             # band rows into the border nodes: rows 0, 1 back across the closure, row
@@ -74,10 +83,17 @@ def gather(Lb, L2, Db, Ub, Gc, Gr, Gd, bd):
             bd.Dm[b + a, q] = Lb[n - 1, a, q]
             bd.Dm[b + a, b + q] = Db[n - 1, a, q]
     for k in range(ng):
+        lo, hi = ni, 0
         for i in range(ni):
+            nonzero = False
             for a in range(b):
                 bd.Bm[2 * b + k, i, a] = Gc[i, a, k]
                 bd.Cm[2 * b + k, i, a] = Gr[k, i, a]
+                nonzero = nonzero or Gc[i, a, k] != 0.0 or Gr[k, i, a] != 0.0
+            if nonzero:
+                lo = min(lo, i)
+                hi = i + 1
+        bd.span[k, 0], bd.span[k, 1] = lo, hi
         for a in range(b):
             bd.Dm[a, 2 * b + k] = Gc[n - 2, a, k]
             bd.Dm[b + a, 2 * b + k] = Gc[n - 1, a, k]
@@ -152,6 +168,39 @@ def border_row_dot(bd, r, y):
 
 
 @njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
+def invert(A, out):
+    """out = A^{-1} by Gauss-Jordan elimination with partial pivoting (A is overwritten);
+    False at a zero pivot. For the border's small matrix (some ten rows), where LAPACK's
+    calls (a determinant to test, then the inverse) cost more than the arithmetic."""
+    n = A.shape[0]
+    for i in range(n):
+        for j in range(n):
+            out[i, j] = 1.0 if i == j else 0.0
+    for k in range(n):
+        p, big = k, abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > big:
+                p, big = i, abs(A[i, k])
+        if not big > 0.0:  # zero (singular) or NaN
+            return False
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+                out[k, j], out[p, j] = out[p, j], out[k, j]
+        f = 1.0 / A[k, k]
+        for j in range(n):
+            A[k, j] *= f
+            out[k, j] *= f
+        for i in range(n):
+            if i != k and A[i, k] != 0.0:
+                m = A[i, k]
+                for j in range(n):
+                    A[i, j] -= m * A[k, j]
+                    out[i, j] -= m * out[k, j]
+    return True
+
+
+@njit(cache=True, error_model="numpy", no_cpython_wrapper=True)
 def schur(bd):
     """bd.Sinv from bd.X = A^{-1} Bm; False when the complement is singular."""
     nb, ni, b = bd.X.shape
@@ -159,9 +208,12 @@ def schur(bd):
     for r in range(2 * b):  # the border nodes' rows: three band rows each
         for q in range(nb):
             S[r, q] -= border_row_dot(bd, r, bd.X[q])
-    if nb > 2 * b:  # the globals' rows, dense: one matrix product (BLAS)
-        S[2 * b:, :] -= np.dot(bd.Cm[2 * b:].reshape(nb - 2 * b, ni * b),
-                               bd.X.reshape(nb, ni * b).T)
+    for k in range(nb - 2 * b):  # the globals' rows, over their spans (BLAS)
+        lo, hi = bd.span[k, 0] * b, bd.span[k, 1] * b
+        if hi > lo:
+            row = bd.Cm[2 * b + k].reshape(ni * b)[lo:hi]
+            for q in range(nb):
+                S[2 * b + k, q] -= np.dot(row, bd.X[q].reshape(ni * b)[lo:hi])
     # scale rows and columns to unit diagonal-ish size: the border mixes metres, N and 1/s
     d = np.ones(nb)
     for r in range(nb):
@@ -173,9 +225,9 @@ def schur(bd):
     Sd = S * d.reshape(nb, 1)
     if not np.all(np.isfinite(Sd)):
         return False
-    if abs(np.linalg.det(Sd)) == 0.0:
+    if not invert(Sd, bd.Sinv):
         return False
-    bd.Sinv[:, :] = np.linalg.inv(Sd) * d.reshape(1, nb)
+    bd.Sinv[:, :] = bd.Sinv * d.reshape(1, nb)
     return np.all(np.isfinite(bd.Sinv))
 
 
@@ -198,14 +250,17 @@ def finish(bd, r, rg, x, dg):
         bd.rb[2 * b + k] = rg[k]
     for q in range(2 * b):
         bd.rb[q] -= border_row_dot(bd, q, x)
-    if nb > 2 * b:  # the globals' rows, dense (BLAS)
-        bd.rb[2 * b:] -= np.dot(bd.Cm[2 * b:].reshape(nb - 2 * b, ni * b),
-                                x[:ni].reshape(ni * b))
+    xf = x[:ni].reshape(ni * b)  # the band's rows, flat: contiguous loops vectorise
+    for k in range(nb - 2 * b):  # the globals' rows, over their spans (BLAS)
+        lo, hi = bd.span[k, 0] * b, bd.span[k, 1] * b
+        if hi > lo:
+            bd.rb[2 * b + k] -= np.dot(bd.Cm[2 * b + k].reshape(ni * b)[lo:hi], xf[lo:hi])
     z = bd.Sinv @ bd.rb
     for q in range(nb):
-        for i in range(ni):
-            for a in range(b):
-                x[i, a] -= bd.X[q, i, a] * z[q]
+        Xq = bd.X[q].reshape(ni * b)
+        zq = z[q]
+        for i in range(ni * b):
+            xf[i] -= Xq[i] * zq
     for a in range(b):
         x[n - 2, a] = z[a]
         x[n - 1, a] = z[b + a]

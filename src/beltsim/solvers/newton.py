@@ -49,6 +49,12 @@ ROUNDOFF_MERIT = 1e-26
 # most halvings of such a step
 CYCLE_ITERATIONS = 8
 MAX_HALVINGS = 8
+# The primal-dual iteration keeps its factorisation for the next iteration (a chord
+# step: the residual and the friction slopes are assembled anew) while its updates shrink
+# by this factor or more: the Jacobian then changes too little to matter, and the
+# bordered factorisation is half of an iteration's cost. A slower contraction, or a
+# growing update, factorises again.
+CHORD = 0.2
 # A friction ratio with slope dlam/ds below NEAR_BOUND (|lam| > 0.995 for tanh) that
 # differs from the law at its slip velocity by more than LAW_GAP is stuck at the bound;
 # while Newton's updates grow, one whose g^-1(lam) lies beyond that slip velocity (over
@@ -323,7 +329,8 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     the round-off floor: below ROUNDOFF_FLOOR * tol and no longer halving. The floor
     grows with the condition number of the Jacobian, ~ (L / h_min)^2, and on very fine
     grids lies above a fixed tol. None of these counts while a friction ratio is stuck
-    at +-1 (:func:`release_stuck_ratios`).
+    at +-1 (:func:`release_stuck_ratios`). The primal-dual form keeps the last
+    factorisation for an iteration after an update that shrank by CHORD or more.
 
     On return, w holds the block LU of the Jacobian last factorised (block_factor)
     and the friction slopes it was assembled with (w.sgf), for the step's error
@@ -345,6 +352,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     if m0 == 0.0:
         return factorise(w, mesh)  # the factors are the step's (its error estimate's)
     previous = np.inf
+    reuse = False
     for it in range(settings.max_iterations):
         st.newton_iterations += 1
         for i in range(n):
@@ -352,7 +360,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
             R[i, 1] = -R[i, 1]
         for k in range(ng):
             Rg[k] = -Rg[k]
-        if not factorise(w, mesh):
+        if not reuse and not factorise(w, mesh):
             st.merit = merit(R, Rg, scales)
             return False
         linear_solve(w, mesh, R, Rg, dx, dg)
@@ -386,6 +394,7 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
                 friction_forces(lam, fnode, u, g, t, mesh, p, drive)
                 return True
             assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)
+            reuse = it >= 1 and update < CHORD * previous
             previous = update
             continue
         alpha = 1.0
