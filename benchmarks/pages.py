@@ -54,13 +54,19 @@ SERPENTINE_ARGS = {
             "--peer-cap", "300"],
     True: ["serpentine_accessory", "--elements", "60", "--repeat", "1", "--grids", "",
            "--no-kernels", "--peers", "newton,hybr,bdf2", "--peer-cap", "30"]}
+#: the crankshaft's fluctuation (benchmarks.fluctuation), by mode: simulated seconds after
+#: the start-up ramp, the laws, and overrides
+FLUCTUATION = {False: {"seconds": 1.0, "laws": ("tanh", "exact"), "sets": ()},
+               True: {"seconds": 0.02, "laws": ("tanh",),
+                      "sets": (("numerics.elements", 120),)}}
 TITLE = "Timings"
 INDEX_INTRO = (
     "How fast beltsim runs, measured by `python -m benchmarks.pages` on the machine its "
     "page names: the default run of the paper slip scene, the steady scheme, the explicit "
     "kernel, compilation and a cold start, against generic scipy peers and a numpy port "
     "of the default scheme; and the closed belt drive's start-up and steady scheme, run by "
-    "the same engine as a closed layout. `python -m benchmarks.pages --quick` does the "
+    "the same engine as a closed layout, and a second of a crankshaft's speed "
+    "fluctuation on the accessory drive. `python -m benchmarks.pages --quick` does the "
     "same on tiny grids (CI runs it).")
 
 _KERNEL_LOAD = """
@@ -235,6 +241,7 @@ def build(page: Page, quick: bool, cold: bool = True) -> None:
     _steady_section(page, quick, repeat)
     _drive_section(page, quick, cold)
     _serpentine_section(page, quick)
+    _fluctuation_section(page, quick)
     page.para(f"Load average at the end of the run: {os.getloadavg()[0]:.2f} (at the start: "
               f"see the top of the page); on this machine {os.cpu_count()} cores.")
 
@@ -378,6 +385,35 @@ def _serpentine_section(page: Page, quick: bool) -> None:
         page.para(f"{pe['elements']} elements; {label}: the fastest peer that reached our "
                   f"state took {fmt(best, '.3g') + ' times' if best else 'none reached it:'}"
                   f" our solve's wall.")
+
+
+def _fluctuation_section(page: Page, quick: bool) -> None:
+    from beltsim.api import shipped_scene
+
+    from . import fluctuation
+
+    cfg = FLUCTUATION[quick]
+    page.heading("A fluctuating crankshaft")
+    page.para(
+        f"`python -m benchmarks.fluctuation serpentine_accessory --seconds "
+        f"{cfg['seconds']:g}` (its functions, called here): the shipped accessory drive "
+        f"from rest with the crankshaft's speed a sine (its speed +- "
+        f"{fluctuation.AMPLITUDE:g} rad/s at {fluctuation.FREQUENCY:g} Hz) through its "
+        f"start-up ramp and {cfg['seconds']:g} simulated second(s) more, by the default "
+        f"scheme (esdirk3) under each friction law; the wall time, steps and Newton "
+        f"iterations of the time after the ramp, and the periodic tracker's amplitude of "
+        f"the first span's tension over the last period.")
+    out = fluctuation.bench(shipped_scene("serpentine_accessory"), laws=cfg["laws"],
+                            seconds=cfg["seconds"], sets=cfg["sets"])
+    rows = []
+    for r in out["runs"]:
+        span = next((k for k in r["amplitudes"] if k.startswith("tension[")), None)
+        rows.append([r["law"], r["elements"], fmt(r["wall_time"], ".3g"),
+                     fmt(r["wall_per_second"], ".3g"), r["steps"], r["rejected_steps"],
+                     fmt(r["newton_per_step"], ".3g"),
+                     f"{span}: {r['amplitudes'][span]:.6g} N" if span else ""])
+    page.table(["law", "elements", "wall [s]", "wall per simulated second [s]", "steps",
+                "rejected", "Newton iterations a step", "tension amplitude"], rows)
 
 
 def main(argv=None) -> int:
