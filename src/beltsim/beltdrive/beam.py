@@ -471,7 +471,7 @@ def solve_beam(P: DriveParams, omega1: float | None = None,
     GrossSlipError
         The load exceeds the beam drive's capacity
         (:func:`beltsim.beltdrive.beam.capacity`, in the message; on N pulleys the
-        overloaded pulley's, :func:`layout_capacity`).
+        overloaded pulley's, ``layout_capacity``).
     LiftOffError
         The contact pressure does not stay positive on the arcs.
     NoSolutionError

@@ -128,7 +128,7 @@ def history_keys(P) -> tuple[str, ...]:
     return ("t", "omega1", *LOOP_KEYS, *figure_keys(P.layout.names), *arm, *POWER_KEYS)
 
 
-class _Indices:
+class MeshIndices:
     """What every reading of a loop's state on one mesh indexes with: the strain
     stencil's nodes, the contact nodes with their radii and each arc's nodes (a run reads
     its state at every check; these depend on the mesh alone)."""
@@ -141,11 +141,11 @@ class _Indices:
         self.arcs = [np.flatnonzero(mesh.seg == a) for a in range(len(mesh.seg_radius))]
 
 
-def indices_of(disc) -> _Indices:
-    """The :class:`_Indices` of a discretisation's mesh, made at its first reading."""
+def indices_of(disc) -> MeshIndices:
+    """The :class:`MeshIndices` of a discretisation's mesh, made at its first reading."""
     ix = disc.__dict__.get("_loop_indices")
     if ix is None or ix.mesh is not disc.mesh:
-        ix = _Indices(disc.mesh)
+        ix = MeshIndices(disc.mesh)
         ix.mesh = disc.mesh
         disc._loop_indices = ix
     return ix
