@@ -180,10 +180,9 @@ def run(scene, progress: bool = False, raise_on_failure: bool = True,
     if stability:
         import sys
 
-        from .simulation.stability import stderr_notice
-        from .simulation.stability_check import check
+        from .simulation.stability_check import attach
 
-        result.stability = check(result, notice=stderr_notice(progress or sys.stderr.isatty()))
+        attach(result, notice=progress or sys.stderr.isatty())
     return result
 
 

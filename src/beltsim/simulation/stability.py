@@ -95,6 +95,12 @@ class Stability:
         return cls(**{**data, "modes": tuple(tuple(m) for m in data.get("modes", ()))})
 
     @property
+    def resolved_modes(self) -> tuple:
+        """What a physical transient resolves: ``modes``, or the least stable mode alone
+        where they are not listed (a discrete estimate)."""
+        return self.modes or ((self.rate, self.frequency),)
+
+    @property
     def unstable(self) -> bool:
         """Whether the mode grows by more than the estimate's error."""
         return self.rate > (self.error or 0.0)
@@ -127,16 +133,11 @@ class Stability:
             return None
         text = (f"the steady state is unstable in the model: a mode at "
                 f"{self.frequency:.4g} Hz grows at {self.rate:.3g} 1/s")
-        damping = [v for v in (self.grid_damping, self.step_damping) if v is not None]
-        if damping:
-            total = sum(damping)
-            parts = []
-            if self.grid_damping is not None:
-                parts.append(f"grid {self.grid_damping:.3g}")
-            if self.step_damping is not None:
-                parts.append(f"time steps {self.step_damping:.3g}")
-            text += (f"; this run's scheme damps it by about {total:.3g} 1/s "
-                     f"({', '.join(parts)})")
+        parts = [(name, v) for name, v in (("grid", self.grid_damping),
+                                           ("time steps", self.step_damping)) if v is not None]
+        if parts:
+            text += (f"; this run's scheme damps it by about {sum(v for _, v in parts):.3g} "
+                     f"1/s ({', '.join(f'{name} {v:.3g}' for name, v in parts)})")
         text += '; numerics.transient = "physical" follows its growth'
         return text
 
@@ -248,8 +249,8 @@ def physical_step(found: Stability, integrator: str) -> float:
     the least stable rate: the step limit of a physical transient
     (``numerics.transient = "physical"``)."""
     bound = PHYSICAL_DAMPING * max(abs(found.rate), 1.0)
-    modes = found.modes or ((found.rate, found.frequency),)
-    return min(_step_for(complex(r, 2 * math.pi * f), integrator, bound) for r, f in modes)
+    return min(_step_for(complex(r, 2 * math.pi * f), integrator, bound)
+               for r, f in found.resolved_modes)
 
 
 #: A physical transient's checks (its history's rows) per period of the highest growing
@@ -260,8 +261,7 @@ SAMPLES_PER_PERIOD = 8
 def physical_sampling(found: Stability) -> float:
     """A physical transient's check interval (s): ``SAMPLES_PER_PERIOD`` checks per period
     of the highest growing root in ``found.modes``, so that its history resolves them."""
-    modes = found.modes or ((found.rate, found.frequency),)
-    return 1.0 / (SAMPLES_PER_PERIOD * max(f for _, f in modes))
+    return 1.0 / (SAMPLES_PER_PERIOD * max(f for _, f in found.resolved_modes))
 
 
 def _step_for(lam: complex, integrator: str, bound: float) -> float:

@@ -54,7 +54,9 @@ def discrete_least_stable(scene, notice=None) -> Stability:
     """The rightmost eigenvalue of the discrete model with the central gyroscopic form on
     the scene's grid, its error estimated as its difference from the same on half the
     grid; cached per scene and grid."""
-    key = cache.key_of("stability", [FORMAT, "discrete", physics_of(scene), _elements(scene)])
+    # the grid as the scene states it (its default when unset): no discretisation needed
+    elements = scene.to_dict().get("numerics", {}).get("elements")
+    key = cache.key_of("stability", [FORMAT, "discrete", physics_of(scene), elements])
     found = cache.load(key)
     if found is not None:
         return Stability.from_dict(found)
@@ -77,12 +79,6 @@ def _has_exact(scene) -> bool:
     except analytic.NoSolutionError:
         return False
     return True
-
-
-def _elements(scene) -> int:
-    from .. import solvers
-
-    return solvers.discretise(scene).grid.n_elements
 
 
 def _rightmost(scene, elements=None) -> tuple[complex, int]:

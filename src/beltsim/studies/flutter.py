@@ -51,19 +51,17 @@ class FlutterLog(Tracker):
         x = sim.grid.x
         self._j = int(np.clip(np.searchsorted(x, self.probe), 1, x.size - 1))
         self._w = (self.probe - x[self._j - 1]) / (x[self._j] - x[self._j - 1])
+        # the slip front where the belt slides, the concentrated force in perfect adhesion
+        self._front = ("slip_start" if sim.params.friction == "coulomb"
+                       else "concentrated_force")
 
     def handle(self, sim):
         """Record this check; a stop once the friction leaves its steady value by more
         than ``NO_CYCLE`` of it."""
-        sol = sim.solution()
-        summary = sol.summary()
-        front = summary.get("slip_start")
-        if front is None:
-            front = summary.get("concentrated_force")
         u = sim.state.u
         self.t.append(sim.t)
         self.friction.append(sim.total_friction())
-        self.front.append(np.nan if front is None else front)
+        self.front.append(getattr(sim.solution(), self._front))
         self.u.append((1 - self._w) * u[self._j - 1] + self._w * u[self._j])
         if abs(self.friction[-1] - self.steady) > NO_CYCLE * abs(self.steady):
             return Stop(reason=f"no limit cycle: the total friction left its steady value "
