@@ -47,6 +47,7 @@ linearly from 0 to [[eps_b]].
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -511,8 +512,13 @@ def solve(scene_or_params, model: str | None = None) -> AnalyticSolution:
     P = scene_or_params.params if isinstance(scene_or_params, Scene) else scene_or_params
     if model is None:
         model = "stick" if P.friction == "stick" else "slip"
-    if model == "stick":
-        return solve_stick(P)
-    if model == "slip":
-        return solve_slip(P)
-    raise ValueError(f"model: must be 'stick' or 'slip', got {model!r}")
+    if model not in ("stick", "slip"):
+        raise ValueError(f"model: must be 'stick' or 'slip', got {model!r}")
+    return _solved(P, model)
+
+
+@functools.lru_cache(maxsize=64)
+def _solved(P: Params, model: str) -> AnalyticSolution:
+    """One solve per physics: a run asks for its exact state up to three times (its
+    error block, its stability check, its slip-start estimate)."""
+    return solve_stick(P) if model == "stick" else solve_slip(P)
