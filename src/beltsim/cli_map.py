@@ -20,6 +20,7 @@ def cmd_stability_map(args):
     from .api import load_scene
     from .cli_text import float_list, map_header, map_row
     from .io.files import prepare_outdir, write_atomic, write_csv
+    from .problem.kinds import is_drive_scene
     from .studies import stability_map as study
 
     if not (args.tol > 0):
@@ -27,15 +28,16 @@ def cmd_stability_map(args):
     scene = load_scene(args.scene, args.overrides)
     study.check_scene(scene, args.param)
     values = (float_list(args.values, "--values") if args.values is not None
-              else study.DEFAULT_VALUES[args.param])
+              else study.default_values(scene, args.param))
     try:
         values = study.check_values(scene, args.param, values)
     except SceneError as exc:
         raise UsageError(f"--values: {exc}") from None
     out = prepare_outdir(args.out or Path("runs/out") / f"stability_map_{Path(args.scene).stem}"
                          f"_{args.param}")
-    print(f"least stable exact root up to {_band():g} Hz, by {args.param} "
-          f"({study.PARAMS[args.param]})", flush=True)
+    how = ("rightmost eigenvalue of the discrete model (central form) with its error"
+           if is_drive_scene(scene) else f"least stable exact root up to {_band():g} Hz")
+    print(f"{how}, by {args.param} ({study.params_of(scene)[args.param]})", flush=True)
     print(map_header(args.param, study.UNITS[args.param]), flush=True)
     rows = study.sweep(scene, args.param, values,
                        progress=lambda row: print(map_row(row), flush=True))
@@ -77,20 +79,34 @@ def add_parser(sub, add_scene_args) -> None:
     add_scene_args : callable
         ``add_scene_args(parser)`` adds SCENE and ``--set`` as every scene command has them.
     """
-    from .studies.stability_map import DEFAULT_VALUES, PARAMS, TOLERANCE
+    from .studies.stability_map import (
+        DEFAULT_VALUES,
+        DRIVE_DEFAULT_VALUES,
+        DRIVE_PARAMS,
+        PARAMS,
+        TOLERANCE,
+    )
 
-    p = sub.add_parser("stability-map", help="the least stable exact root of a straight "
-                       "belt's steady state over one parameter (stability_map.csv), and the "
-                       "damping a stable state needs")
+    def defaults(table):
+        return "; ".join(f"{k} " + ",".join(f"{v:g}" for v in vals)
+                         for k, vals in table.items())
+
+    p = sub.add_parser("stability-map", help="the least stable root of a scene's steady "
+                       "state over one parameter (stability_map.csv), and the damping a "
+                       "stable state needs: exact roots for a straight belt, the discrete "
+                       "estimate with its error for a closed drive")
     add_scene_args(p)
-    p.add_argument("--param", choices=tuple(PARAMS), default="damping",
-                   help="the parameter swept: physics.damping, contact.max_friction, or "
-                        "motion.belt_speed with the surface speed at the scene's v/c "
+    p.add_argument("--param", choices=tuple(dict.fromkeys([*PARAMS, *DRIVE_PARAMS])),
+                   default="damping",
+                   help="the parameter swept; a straight belt's: physics.damping, "
+                        "contact.max_friction, or motion.belt_speed with the surface speed "
+                        "at the scene's v/c; a closed drive's: physics.damping, "
+                        "contact.friction_coefficient, or the driver's speed "
                         "(default damping)")
     p.add_argument("--values", default=None, metavar="V1,V2,...",
-                   help="its values, comma-separated (default: "
-                        + "; ".join(f"{k} " + ",".join(f"{v:g}" for v in vals)
-                                    for k, vals in DEFAULT_VALUES.items()) + ")")
+                   help="its values, comma-separated (default, straight belt: "
+                        + defaults(DEFAULT_VALUES) + "; closed drive: "
+                        + defaults(DRIVE_DEFAULT_VALUES) + ")")
     p.add_argument("--critical-damping", action="store_true",
                    help="also find the smallest damping with no growing root in the band "
                         "(bisection on d; critical_damping.json)")

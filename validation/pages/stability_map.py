@@ -1,6 +1,7 @@
 """Page: a stability map of the paper's inertial steady states, the least stable exact root
 over the damping d, the friction limit f* and the belt speed c, and the damping a stable
-steady state needs (:mod:`beltsim.studies.stability_map`).
+steady state needs; and of the closed drives, by their discrete estimate over d and the
+friction coefficient (:mod:`beltsim.studies.stability_map`).
 
 A page of its own rather than a section of the spectrum page: it depends on the map's
 study module, which the spectrum page does not, and it is rewritten in minutes where the
@@ -22,13 +23,19 @@ from beltsim.studies import stability_map as study
 
 from .kit import Page, decorate, fmt, num
 
-TITLE = "A stability map of the paper's steady states"
+TITLE = "A stability map of the paper's steady states and of the drives"
 SCENES = ("paper_slip", "paper_inertia")
+#: the closed drives mapped, each on its own grid (the quick page: a coarse one)
+DRIVES = ("drive_flat", "serpentine_accessory")
 CFG = {False: {"scenes": SCENES, "dampings": study.DEFAULT_VALUES["damping"],
                "frictions": study.DEFAULT_VALUES["max_friction"],
-               "speeds": study.DEFAULT_VALUES["belt_speed"], "tol": study.TOLERANCE},
+               "speeds": study.DEFAULT_VALUES["belt_speed"], "tol": study.TOLERANCE,
+               "drives": DRIVES, "drive_elements": None,
+               "drive_dampings": study.DRIVE_DEFAULT_VALUES["damping"],
+               "drive_mus": study.DRIVE_DEFAULT_VALUES["friction_coefficient"]},
        True: {"scenes": ("paper_slip",), "dampings": (39.0, 200.0), "frictions": (1e4,),
-              "speeds": (100.0,), "tol": 40.0}}
+              "speeds": (100.0,), "tol": 40.0, "drives": ("drive_flat",),
+              "drive_elements": 60, "drive_dampings": (0.0, 80.0), "drive_mus": (0.4,)}}
 
 
 @contextlib.contextmanager
@@ -213,6 +220,72 @@ def stable_speeds(rows) -> str:
     return f"c = {', '.join(speeds)} m/s" if speeds else "none of these speeds"
 
 
+def _drive(name: str, cfg: dict):
+    scene = shipped_scene(name)
+    n = cfg["drive_elements"]
+    return scene if n is None else scene.with_overrides({"numerics.elements": n})
+
+
+def drive_cells(row: dict) -> list:
+    """(status, rate +- error, frequency) of a drive's point."""
+    if row["rate"] is None:
+        return [row["status"], "", ""]
+    return [row["status"], f"{row['rate']:+.2f} ± {row['error']:.2g}",
+            f"{row['frequency']:.0f}"]
+
+
+def drive_section(page: Page, cfg: dict) -> None:
+    n = cfg["drive_elements"]
+    grid = "" if n is None else f" --set numerics.elements={n}"
+    page.heading("The closed drives")
+    page.para(
+        "A closed drive has no exact spectrum. Its point is what its runs report: the "
+        "rightmost eigenvalue of the discrete model with the central gyroscopic form on "
+        "the scene's grid, for frequencies up to 1.5 times the grid's highest axial "
+        "frequency (`beltsim.simulation.stability_check.discrete_least_stable`), with its "
+        "error, the difference from the same on half the grid; a rate within its error "
+        "either way is undecided. Above that band the central form has grid-scale "
+        "eigenvalues, some growing, whose frequency doubles with the grid: they are left "
+        "out (the tests check the sweep against every eigenvalue of the band by the QZ "
+        "algorithm). Commands: `beltsim stability-map SCENE" + grid + " --param damping "
+        "--values " + ",".join(f"{d:g}" for d in cfg["drive_dampings"]) + "` and `--param "
+        "friction_coefficient --values " + ",".join(f"{m:g}" for m in cfg["drive_mus"])
+        + "` (the default coefficient of every pulley).")
+    for param, values, unit in (("damping", cfg["drive_dampings"], "d [1/s]"),
+                                ("friction_coefficient", cfg["drive_mus"], "mu")):
+        sweeps = {name: study.sweep(_drive(name, cfg), param, values)
+                  for name in cfg["drives"]}
+        header = [unit]
+        for name in cfg["drives"]:
+            header += [f"{name}", "rate [1/s]", "at [Hz]"]
+        rows = []
+        for i, v in enumerate(values):
+            line = [fmt(v, "g")]
+            for name in cfg["drives"]:
+                line += drive_cells(sweeps[name][i])
+            rows.append(line)
+        page.table(header, rows)
+        page.para("Cost: " + "; ".join(f"{name} {computed(r)}"
+                                       for name, r in sweeps.items()) + ".")
+    rows = []
+    for name in cfg["drives"]:
+        start = time.perf_counter()
+        crit = study.critical_damping(_drive(name, cfg), tol=cfg["tol"])
+        at = {r["value"]: r for r in crit.evaluations}
+        cell = crit.describe() if crit.damping is None or crit.lower is None else (
+            f"{crit.damping:.2f} (rate {at[crit.damping]['rate']:+.2f} ± "
+            f"{at[crit.damping]['error']:.2g}; at {crit.lower:.2f}: "
+            f"{at[crit.lower]['rate']:+.2f} ± {at[crit.lower]['error']:.2g})")
+        rows.append([name, cell, str(len(crit.evaluations)),
+                     fmt(time.perf_counter() - start, ".3g")])
+    page.table(["drive", "critical d [1/s]", "root searches", "wall [s]"], rows)
+    page.para(
+        "The critical damping of a drive is that of its discrete estimate: where the "
+        "estimate's error exceeds the rate near the crossing, the crossing itself is "
+        "known only to within the d that moves the rate by that error. Command: "
+        f"`beltsim stability-map SCENE{grid} --critical-damping --tol {cfg['tol']:g}`.")
+
+
 def figure(page: Page, sweeps: dict, crit: dict) -> None:
     import matplotlib.pyplot as plt
 
@@ -253,4 +326,5 @@ def build(page: Page, quick: bool) -> None:
         friction_section(page, cfg)
         speed_section(page, cfg)
         figure(page, sweeps, crit)
+        drive_section(page, cfg)
         page.para(f"Wall time of the whole map: {time.perf_counter() - start:.0f} s.")

@@ -1,11 +1,17 @@
-"""A stability map of a straight belt's steady state: the least stable exact root over
-one parameter, and the damping a stable steady state needs.
+"""A stability map of a scene's steady state: the least stable root over one parameter,
+and the damping a stable steady state needs; of a straight belt or a closed drive.
 
-Each point is the least stable root of the continuous model linearised about the exact
-steady state, up to ``BAND_HZ`` of :mod:`beltsim.simulation.stability`
+For a straight belt each point is the least stable root of the continuous model
+linearised about the exact steady state, up to ``BAND_HZ`` of
+:mod:`beltsim.simulation.stability`
 (:func:`~beltsim.simulation.stability.exact_least_stable`, cached per scene: seconds
-when computed, milliseconds when cached). No run and no grid is involved. The
-parameters (``PARAMS``):
+when computed, milliseconds when cached). No run and no grid is involved. For a closed
+drive, which has no exact spectrum, it is the rightmost eigenvalue of the discrete model
+(central form) on the scene's grid with its error, the difference from half the grid
+(:func:`~beltsim.simulation.stability_check.discrete_least_stable`, as a run reports
+it; cached too); a point whose rate lies within that error is ``UNDECIDED``.
+
+A straight belt's parameters (``PARAMS``):
 
 ``damping``
     d (1/s), ``physics.damping``; the steady state does not depend on it, only its
@@ -18,6 +24,11 @@ parameters (``PARAMS``):
     the slip ratio v/c stays the scene's (1.01 in the paper's scenes). The damping d and
     the friction limit stay the scene's: d is a rate in 1/s, not a fraction of a mode's
     critical damping, so it is not rescaled with c.
+
+A closed drive's (``DRIVE_PARAMS``): ``damping`` as above; ``friction_coefficient``, the
+default coefficient mu of every pulley, ``contact.friction_coefficient`` (a pulley with a
+coefficient of its own keeps it); ``driver_speed`` (rad/s), the driver's speed
+(``pulley.NAME.speed``, or ``drive.driver_speed`` in the two-pulley shorthand), a number.
 
 A value at which the scene has no exact steady state (lift-off, gross slip:
 :class:`~beltsim.errors.NoSolutionError`) is recorded as such, never as a number; so is
@@ -33,18 +44,29 @@ import time
 from dataclasses import dataclass, field
 
 from ..errors import BeltsimError, NoSolutionError, UsageError
+from ..problem.kinds import is_drive_scene
 
-#: The parameters a map sweeps, each with the scene key it sets
+#: The parameters a straight belt's map sweeps, each with the scene key it sets
 PARAMS = {"damping": "physics.damping", "max_friction": "contact.max_friction",
           "belt_speed": "motion.belt_speed"}
+#: A closed drive's (the driver's speed key depends on the layout: :func:`overrides`)
+DRIVE_PARAMS = {"damping": "physics.damping",
+                "friction_coefficient": "contact.friction_coefficient",
+                "driver_speed": "the driver's speed"}
 #: Their units, for tables
-UNITS = {"damping": "1/s", "max_friction": "N/m", "belt_speed": "m/s"}
+UNITS = {"damping": "1/s", "max_friction": "N/m", "belt_speed": "m/s",
+         "friction_coefficient": "1", "driver_speed": "rad/s"}
 #: The values a map takes when none are given: around the paper's scenes (d = 39 1/s,
 #: f* = 1e5 N/m, c = 120 m/s); f* down to full slip (no stick zone below about 1.5e4),
 #: c up to just below the critical speed sqrt(a/I) = 129.1 m/s
 DEFAULT_VALUES = {"damping": (0.0, 20.0, 39.0, 60.0, 100.0, 150.0, 200.0, 300.0),
                   "max_friction": (1e4, 2e4, 3e4, 5e4, 1e5, 3e5, 1e6, 1e7),
                   "belt_speed": (40.0, 60.0, 80.0, 100.0, 110.0, 120.0, 125.0, 128.0)}
+#: A closed drive's: d around the shipped drives' 20 1/s; mu down towards gross slip of
+#: the shipped drives' rated loads; driver speeds around their 150 rad/s
+DRIVE_DEFAULT_VALUES = {"damping": (0.0, 5.0, 10.0, 20.0, 40.0, 80.0),
+                        "friction_coefficient": (0.3, 0.4, 0.5, 0.7, 1.0),
+                        "driver_speed": (50.0, 100.0, 150.0, 200.0, 300.0)}
 #: The width (1/s in d) to which :func:`critical_damping` narrows its bracket
 TOLERANCE = 0.5
 #: The largest damping (1/s) :func:`critical_damping` tries before it gives up
@@ -54,10 +76,23 @@ MAX_DAMPING = 1.0e4
 UNSTABLE = "unstable"
 #: Every root found in the band decays (or is neutral: rate 0 counts as stable)
 STABLE = "stable"
+#: A discrete estimate whose rate lies within its error either way (a closed drive)
+UNDECIDED = "undecided"
 #: No exact steady state at this value (NoSolutionError)
 NO_STEADY_STATE = "no steady state"
 #: A steady state, but the search found no root in the band
 NO_ROOT = "no root found"
+
+
+def params_of(scene) -> dict:
+    """The parameters a map of ``scene`` sweeps: ``DRIVE_PARAMS`` for a closed drive,
+    else ``PARAMS``."""
+    return DRIVE_PARAMS if is_drive_scene(scene) else PARAMS
+
+
+def default_values(scene, param: str) -> tuple:
+    """The values a map of ``param`` takes when none are given."""
+    return (DRIVE_DEFAULT_VALUES if is_drive_scene(scene) else DEFAULT_VALUES)[param]
 
 
 def check_scene(scene, param: str) -> None:
@@ -65,29 +100,34 @@ def check_scene(scene, param: str) -> None:
 
     Parameters
     ----------
-    scene : Scene
+    scene : Scene or DriveScene
         The scene to map.
     param : str
-        One of ``PARAMS``.
+        One of :func:`params_of` the scene.
 
     Raises
     ------
     UsageError
-        An unknown parameter; a closed drive, a quasistatic scene or a periodic one (no
-        exact steady state to linearise about); ``max_friction`` of a perfect-adhesion
-        scene; ``belt_speed`` with a surface speed that is a profile, not a number.
+        A parameter that is not the layout's; a quasistatic scene or a periodic one (no
+        steady state to linearise about); ``max_friction`` of a perfect-adhesion scene;
+        ``belt_speed`` with a surface speed that is a profile, not a number; a drive's
+        ``driver_speed`` that is a table, not a number.
     """
-    from ..problem.kinds import is_drive_scene
     from ..simulation.stability import applies
 
-    if param not in PARAMS:
-        raise UsageError(f"--param: unknown parameter {param!r} ({', '.join(PARAMS)})")
-    if is_drive_scene(scene):
-        raise UsageError("stability-map: a closed drive has no exact spectrum; "
-                         "the map is of a straight belt")
+    names = params_of(scene)
+    if param not in names:
+        kind = "a closed drive" if is_drive_scene(scene) else "a straight belt"
+        raise UsageError(f"--param: {param!r} is not a parameter of {kind}'s map "
+                         f"({', '.join(names)})")
     if not applies(scene):
         raise UsageError("stability-map: the scene must be inertial (physics.inertia = true) "
                          "and settle (no sine in its profiles)")
+    if is_drive_scene(scene):
+        if param == "driver_speed" and not isinstance(_driver_speed(scene)[1], (int, float)):
+            raise UsageError("--param driver_speed: the driver's speed must be a number "
+                             "(ramped from rest), not a table")
+        return
     data = scene.to_dict()
     if param == "max_friction" and data["contact"]["friction"] == "stick":
         raise UsageError("--param max_friction: the scene is perfect adhesion "
@@ -107,7 +147,7 @@ def overrides(scene, param: str, value: float) -> list:
     scene : Scene
         The scene mapped.
     param : str
-        One of ``PARAMS``.
+        One of :func:`params_of` the scene.
     value : float
         The parameter's value.
 
@@ -116,12 +156,23 @@ def overrides(scene, param: str, value: float) -> list:
     list of (str, float)
         ``belt_speed`` sets the surface speed too, at the scene's ratio v/c.
     """
-    keys = [(PARAMS[param], float(value))]
+    if param == "driver_speed":
+        return [(_driver_speed(scene)[0], float(value))]
+    keys = [(params_of(scene)[param], float(value))]
     if param == "belt_speed":
         motion = scene.to_dict()["motion"]
         ratio = motion["surface_speed"] / motion["belt_speed"]
         keys.append(("motion.surface_speed", ratio * float(value)))
     return keys
+
+
+def _driver_speed(scene) -> tuple[str, object]:
+    """A drive's key of its driver's speed, and the speed as the scene gives it."""
+    data = scene.to_dict()
+    if "pulley" not in data:  # the two-pulley shorthand
+        return "drive.driver_speed", data["drive"]["driver_speed"]
+    driver = next(p for p in data["pulley"] if "speed" in p)
+    return f"pulley.{driver['name']}.speed", driver["speed"]
 
 
 def check_values(scene, param: str, values) -> list[float]:
@@ -132,7 +183,7 @@ def check_values(scene, param: str, values) -> list[float]:
     scene : Scene
         The scene mapped.
     param : str
-        One of ``PARAMS``.
+        One of :func:`params_of` the scene.
     values : iterable of float
         The parameter's values.
 
@@ -152,25 +203,26 @@ def check_values(scene, param: str, values) -> list[float]:
 
 
 def point(scene, param: str, value: float) -> dict:
-    """The least stable exact root of ``scene`` with ``param`` set to ``value``.
+    """The least stable root of ``scene`` with ``param`` set to ``value``.
 
     Parameters
     ----------
-    scene : Scene
-        A straight belt that :func:`check_scene` accepts.
+    scene : Scene or DriveScene
+        A scene that :func:`check_scene` accepts.
     param : str
-        One of ``PARAMS``.
+        One of :func:`params_of` the scene.
     value : float
         The parameter's value.
 
     Returns
     -------
     dict
-        ``value``; ``status`` (``UNSTABLE``, ``STABLE``,
+        ``value``; ``status`` (``UNSTABLE``, ``STABLE``, ``UNDECIDED``,
         ``NO_STEADY_STATE`` or ``NO_ROOT``); ``rate`` (1/s), ``frequency``
-        (Hz) and ``growing`` (how many roots in the band grow), each None unless a root
-        was found; ``reason`` (why there is none, else empty); ``cached`` (whether the
-        root came from the cache) and ``wall_time`` (s).
+        (Hz) and ``growing`` (how many roots in the band grow; a drive's estimate: 1 or
+        0), each None unless a root was found; ``error`` (1/s, a drive's estimate's;
+        None for exact roots); ``reason`` (why there is none, else empty); ``cached``
+        (whether the root came from the cache) and ``wall_time`` (s).
 
     Raises
     ------
@@ -178,21 +230,27 @@ def point(scene, param: str, value: float) -> dict:
         The scene's rules refuse the value.
     """
     from ..simulation.stability import exact_least_stable
+    from ..simulation.stability_check import discrete_least_stable
 
     varied = scene.with_overrides(overrides(scene, param, value))
     computed = []
     row = {"value": float(value), "status": NO_ROOT, "rate": None, "frequency": None,
-           "growing": None, "reason": "", "cached": True}
+           "growing": None, "error": None, "reason": "", "cached": True}
+    search = discrete_least_stable if is_drive_scene(scene) else exact_least_stable
     start = time.perf_counter()
     try:
-        found = exact_least_stable(varied, notice=computed.append)
+        found = search(varied, notice=computed.append)
     except NoSolutionError as exc:
         row.update(status=NO_STEADY_STATE, reason=str(exc))
     except BeltsimError as exc:  # the steady state exists, but no root was found
         row.update(status=NO_ROOT, reason=str(exc))
     else:
-        row.update(status=UNSTABLE if found.rate > 0.0 else STABLE, rate=found.rate,
-                   frequency=found.frequency, growing=found.growing)
+        # an exact root's rate of 0 counts as stable; an estimate's sign within its error
+        # is undecided
+        status = found.verdict if found.error is not None else (
+            UNSTABLE if found.rate > 0.0 else STABLE)
+        row.update(status=status, rate=found.rate, frequency=found.frequency,
+                   growing=found.growing, error=found.error)
     row.update(cached=not computed, wall_time=time.perf_counter() - start)
     return row
 
@@ -205,7 +263,7 @@ def sweep(scene, param: str, values, progress=None) -> list[dict]:
     scene : Scene
         A straight belt that :func:`check_scene` accepts.
     param : str
-        One of ``PARAMS``.
+        One of :func:`params_of` the scene.
     values : iterable of float
         The parameter's values.
     progress : callable, optional
@@ -275,7 +333,8 @@ class CriticalDamping:
 
 def critical_damping(scene, tol: float = TOLERANCE, max_damping: float = MAX_DAMPING,
                      progress=None) -> CriticalDamping:
-    """The smallest damping d at which the scene's least stable exact rate is <= 0.
+    """The smallest damping d at which the scene's least stable rate is <= 0 (a drive's:
+    the discrete estimate's, whose error each evaluation records).
 
     Bracketing, then bisection on d. From the scene's own d: if the rate there is > 0,
     d is doubled (from 50 1/s when it is 0) until the rate is <= 0; if it is already
@@ -288,8 +347,8 @@ def critical_damping(scene, tol: float = TOLERANCE, max_damping: float = MAX_DAM
 
     Parameters
     ----------
-    scene : Scene
-        An inertial straight belt with a constant or tabulated (not sine) drive.
+    scene : Scene or DriveScene
+        An inertial scene that settles (:func:`check_scene`).
     tol : float, optional
         The bracket's final width (1/s in d); default ``TOLERANCE``.
     max_damping : float, optional
@@ -361,8 +420,8 @@ def critical_damping(scene, tol: float = TOLERANCE, max_damping: float = MAX_DAM
 
 
 #: The columns of a map's CSV, in order (text columns: ``TEXT_COLUMNS``)
-COLUMNS = ("value", "status", "rate", "frequency", "growing", "cached", "wall_time",
-           "reason")
+COLUMNS = ("value", "status", "rate", "frequency", "growing", "error", "cached",
+           "wall_time", "reason")
 TEXT_COLUMNS = ("status", "reason")
 
 
