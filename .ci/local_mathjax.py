@@ -3,7 +3,8 @@
 Usage: ``python .ci/local_mathjax.py BUILT_HTML_DIR``. Reads every HTML page of the site
 (no browser, about a second) and exits 1, naming the page and the script, when a page
 
-- loads a script from the network (``http:``, ``https:`` or ``//``): offline it is missing;
+- loads a script or a stylesheet from the network (``http:``, ``https:`` or ``//``):
+  offline it is missing (an animation's buttons drawn by a CDN's icon font, blank);
 - has maths (``class="math``) but no MathJax script;
 - names a MathJax script that is not a file of the built site.
 
@@ -27,12 +28,15 @@ class Scripts(HTMLParser):
     def __init__(self):
         super().__init__()
         self.sources: list[str] = []
+        self.styles: list[str] = []
         self.maths = False
 
     def handle_starttag(self, tag, attrs):
         attrs = dict(attrs)
         if tag == "script" and attrs.get("src"):
             self.sources.append(attrs["src"])
+        if tag == "link" and "stylesheet" in (attrs.get("rel") or "").split():
+            self.styles.append(attrs.get("href") or "")
         if "math" in (attrs.get("class") or "").split():
             self.maths = True
 
@@ -53,6 +57,9 @@ def problems(site: Path) -> list[str]:
         for src in parser.sources:
             if src.lower().startswith(REMOTE):
                 found.append(f"{name}: loads a script from the network: {src}")
+        for href in parser.styles:
+            if href.lower().startswith(REMOTE):
+                found.append(f"{name}: loads a stylesheet from the network: {href}")
         for src in mathjax:
             if src.lower().startswith(REMOTE):
                 continue
@@ -75,8 +82,8 @@ def main(argv: list[str]) -> int:
     if found:
         return 1
     pages = sum(1 for p in site.rglob("*.html") if not p.is_relative_to(site / "_static"))
-    print(f"local mathjax: {pages} pages load no script from the network; MathJax is the "
-          f"site's own")
+    print(f"local mathjax: {pages} pages load no script or stylesheet from the network; "
+          f"MathJax is the site's own")
     return 0
 
 

@@ -96,7 +96,7 @@ sphinx_gallery_conf = {
     "download_all_examples": False,
     "write_computation_times": False,
     "remove_config_comments": True,
-    "matplotlib_animations": False,
+    "matplotlib_animations": True,
     "image_scrapers": ("matplotlib",),
     "plot_gallery": "True",
 }

@@ -56,6 +56,9 @@ def test_a_site_with_its_own_mathjax_passes(tmp_path, capsys):
     (CDN, True, "loads a script from the network: https://cdn.jsdelivr.net"),
     (LOCAL + '<script src="//example.org/x.js"></script>', True,
      "loads a script from the network: //example.org"),
+    (LOCAL + '<link rel="stylesheet" href="https://maxcdn.bootstrapcdn.com/font-awesome/'
+              '4.4.0/css/font-awesome.min.css">', True,
+     "loads a stylesheet from the network: https://maxcdn.bootstrapcdn.com"),
     (LOCAL, False, "its MathJax script ../_static/mathjax/tex-chtml.js is not in the built"),
     ("", True, "has maths but loads no MathJax"),
 ])
@@ -73,6 +76,28 @@ def test_a_page_that_needs_the_network_or_misses_its_mathjax_fails(
 
 def test_an_empty_folder_is_not_a_built_site(tmp_path):
     assert _checker().main([str(tmp_path)]) == 1
+
+
+def test_an_animations_cdn_icons_become_the_sites_own_style():
+    """The docs' extension swaps the Font Awesome link of matplotlib's animation controls
+    for a local style that draws every button of the control bar."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "docs" / "_ext"))
+    try:
+        import beltsim_html
+    finally:
+        sys.path.pop(0)
+    link = ('<link rel="stylesheet" href="https://maxcdn.bootstrapcdn.com/font-awesome/'
+            '4.4.0/css/font-awesome.min.css">')
+    buttons = "".join(f'<button><i class="fa fa-{n}"></i></button>'
+                      for n in ("fast-backward", "step-backward", "play", "pause",
+                                "step-forward", "fast-forward", "minus", "plus"))
+    context = {"body": f"<div>{link}{buttons}</div>"}
+    beltsim_html._offline_buttons(None, "examples/x", None, context, None)
+    assert "maxcdn" not in context["body"] and "<style>" in context["body"]
+    for name in beltsim_html.BUTTONS:
+        assert f".fa-{name}::before" in context["body"]
 
 
 # the Python tutorial's shown values (.ci/run_tutorial.py; CI runs the page as a notebook)

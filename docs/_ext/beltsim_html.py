@@ -1,4 +1,5 @@
-"""The built site's own MathJax, and viewcode's back-links that find their targets.
+"""The built site's own MathJax, viewcode's back-links that find their targets, and
+animations whose buttons need no network.
 
 MathJax
     The pages load MathJax from ``_static/mathjax/``, copied at the end of the build from
@@ -12,6 +13,11 @@ viewcode back-links
     links of ``beltsim.simulation.trackers`` read ``#beltsim.HistoryTracker`` where the
     anchor is ``beltsim.simulation.trackers.HistoryTracker``. Each such link is pointed at
     the anchor its page has; one that still has none fails the build.
+
+Animations
+    The gallery embeds a matplotlib animation as HTML whose play buttons are Font Awesome
+    icons from a CDN: offline they would be blank. The stylesheet's link is replaced by
+    a few rules that draw the same buttons as Unicode symbols.
 """
 
 from __future__ import annotations
@@ -32,6 +38,18 @@ MATHJAX_PATH = "mathjax/tex-chtml.js"
 MATHJAX_PARTS = ("tex-chtml.js", "input/tex", "output/chtml", "ui", "a11y", "sre", "adaptors")
 
 BACKLINK = re.compile(r'(<a class="viewcode-back" href=")([^"#]*)#([^"]+)(")')
+
+FONT_AWESOME = re.compile(r'<link rel="stylesheet"\s+href="https://maxcdn\.bootstrapcdn\.com/'
+                          r'font-awesome/[^"]*"\s*/?>')
+# the icons of matplotlib's animation controls, as text in the two triangles and the bar
+# that every font has (the media-control symbols U+23EE... are missing from many)
+BUTTONS = {"fast-backward": "|\\25C0\\25C0", "step-backward": "\\25C0|", "play": "\\25B6",
+           "pause": "||", "step-forward": "|\\25B6", "fast-forward": "\\25B6\\25B6|",
+           "minus": "\\2212", "plus": "+"}
+BUTTON_STYLE = "<style>" + "".join(
+    f'.fa-{name}::before {{ content: "{glyph}"; }}' for name, glyph in BUTTONS.items()
+) + (".fa { font-style: normal; } .fa-flip-horizontal { display: inline-block; "
+     "transform: scaleX(-1); }</style>")
 
 
 def mathjax_source() -> Path:
@@ -90,7 +108,13 @@ def _fix_backlinks(app, pagename, templatename, context, doctree):
     context["body"] = BACKLINK.sub(fix, context["body"])
 
 
+def _offline_buttons(app, pagename, templatename, context, doctree):
+    if "body" in context and FONT_AWESOME.search(context["body"]):
+        context["body"] = FONT_AWESOME.sub(lambda _: BUTTON_STYLE, context["body"])
+
+
 def setup(app):
     app.connect("html-page-context", _fix_backlinks)
+    app.connect("html-page-context", _offline_buttons)
     app.connect("build-finished", _copy_mathjax)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

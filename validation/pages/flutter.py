@@ -24,9 +24,10 @@ TITLE = "Flutter: the linear phase and the limit cycle"
 #: phase in its span)
 CFG = {False: {"linear": 150, "linear_t": 1.0, "fit": (0.4, 1.0), "kick": 1e-6,
                "grids": (300, 600, 1200), "half": 600, "t_end": 2.5, "adhesion": 600,
-               "check": True},
+               "dampings": (39.0, 0.0), "check": True},
        True: {"linear": 60, "linear_t": 0.15, "fit": (0.05, 0.15), "kick": 1e-6,
-              "grids": (40, 80), "half": 40, "t_end": 0.05, "adhesion": 40, "check": False}}
+              "grids": (40, 80), "half": 40, "t_end": 0.05, "adhesion": 40,
+              "dampings": (39.0, 0.0), "check": False}}
 
 
 def linear_section(page: Page, cfg: dict) -> None:
@@ -62,9 +63,15 @@ def linear_section(page: Page, cfg: dict) -> None:
                  fmt(run.wall_time)]])
 
 
-def cycle_rows(page: Page, cfg: dict) -> tuple[list, dict]:
-    scene = shipped_scene("paper_slip")
-    scene = scene.with_overrides(fixed_law(scene))
+def _scene(name: str, damping: float):
+    """The shipped scene at damping d, its friction law's regularisation held at the
+    default grid's value."""
+    scene = shipped_scene(name).with_overrides({"physics.damping": damping})
+    return scene.with_overrides(fixed_law(scene))
+
+
+def cycle_rows(page: Page, cfg: dict, damping: float) -> tuple[list, dict]:
+    scene = _scene("paper_slip", damping)
     runs = {}
     for n in cfg["grids"]:
         runs[(n, 1.0)] = flutter_run(scene, cfg["t_end"], elements=n)
@@ -83,11 +90,12 @@ def cycle_rows(page: Page, cfg: dict) -> tuple[list, dict]:
     return rows, runs
 
 
-def cycle_section(page: Page, cfg: dict) -> dict:
-    page.heading("From rest to the limit cycle (paper_slip)")
-    rows, runs = cycle_rows(page, cfg)
+def cycle_section(page: Page, cfg: dict, damping: float) -> dict:
+    page.heading(f"From rest to the limit cycle (paper_slip, d = {damping:g} 1/s)")
+    rows, runs = cycle_rows(page, cfg, damping)
     page.para(
-        f"paper_slip from rest to t = {cfg['t_end']:g} s, physical transients (central "
+        f"paper_slip at d = {damping:g} 1/s from rest to t = {cfg['t_end']:g} s, physical "
+        f"transients (central "
         f"form, esdirk3 at the step limit that resolves every growing exact root up to "
         f"{st.BAND_HZ:g} Hz), the friction law's regularisation held at the default grid's "
         f"value on every grid. Over the last 0.2 s: half the peak-to-peak of the total "
@@ -117,11 +125,10 @@ def cycle_section(page: Page, cfg: dict) -> dict:
     return runs
 
 
-def adhesion_section(page: Page, cfg: dict) -> None:
-    page.heading("Perfect adhesion (paper_inertia)")
-    scene = shipped_scene("paper_inertia")
-    scene = scene.with_overrides(fixed_law(scene))
-    run = flutter_run(scene, cfg["t_end"], elements=cfg["adhesion"])
+def adhesion_section(page: Page, cfg: dict, damping: float) -> None:
+    page.heading(f"Perfect adhesion (paper_inertia, d = {damping:g} 1/s)")
+    run = flutter_run(_scene("paper_inertia", damping), cfg["t_end"],
+                      elements=cfg["adhesion"])
     c, p = run.envelope()
     # the growth where the deviation rises through (1e-3, 0.3), past the start-up's
     rising = np.flatnonzero((c > 0.2 * c[-1]) & (p > 1e-3) & (p < 0.3))
@@ -132,7 +139,8 @@ def adhesion_section(page: Page, cfg: dict) -> None:
     else:
         growth = "Its envelope does not rise through 1e-3 to 0.3 in this span."
     page.para(
-        f"paper_inertia from rest, {cfg['adhesion']} elements, to t = {cfg['t_end']:g} s. "
+        f"paper_inertia at d = {damping:g} 1/s from rest, {cfg['adhesion']} elements, to "
+        f"t = {cfg['t_end']:g} s. "
         f"Perfect adhesion has no friction bound: the run ends with: {run.reason}. "
         + growth)
 
@@ -144,15 +152,19 @@ def build(page: Page, quick: bool) -> None:
         "(`numerics.transient = \"physical\"`; theory: docs/theory/stability.md, the delay "
         "loop and what saturates it), recorded by `beltsim.studies.flutter`.")
     linear_section(page, cfg)
-    runs = cycle_section(page, cfg)
-    adhesion_section(page, cfg)
+    runs = {}
+    for d in cfg["dampings"]:
+        runs[d] = cycle_section(page, cfg, d)
+        adhesion_section(page, cfg, d)
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
-    for (n, factor), run in runs.items():
-        c, p = run.envelope()
-        ax.semilogy(c, p, label=f"{n} elements" + ("" if factor == 1.0 else ", step / 2"))
-    decorate(ax, "t [s]", "max |F - F_s| / F_s per window",
-             "paper_slip: the friction's envelope, physical transients")
+    fig, axes = plt.subplots(1, len(runs), figsize=(11, 4), sharey=True,
+                             constrained_layout=True)
+    for ax, (d, ladder) in zip(np.atleast_1d(axes), runs.items()):
+        for (n, factor), run in ladder.items():
+            c, p = run.envelope()
+            ax.semilogy(c, p, label=f"{n} elements" + ("" if factor == 1.0 else ", step / 2"))
+        decorate(ax, "t [s]", "max |F - F_s| / F_s per window",
+                 f"paper_slip, d = {d:g} 1/s: the friction's envelope")
     page.figure(fig, "envelope", "The total friction's deviation from the grid's steady "
                                  "value, largest per 20 ms window, on each grid")

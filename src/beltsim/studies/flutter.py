@@ -135,7 +135,7 @@ class Flutter:
 
 def flutter_run(scene, t_end: float, elements: int | None = None,
                 step_factor: float = 1.0, probe: float | None = None,
-                from_steady: float | None = None) -> Flutter:
+                from_steady: float | None = None, trackers=()) -> Flutter:
     """A physical transient of ``scene`` from rest to ``t_end`` (s), finely sampled.
 
     Parameters
@@ -154,6 +154,9 @@ def flutter_run(scene, t_end: float, elements: int | None = None,
         Start from the discrete steady state (the surface at its speed, no ramp) with u
         perturbed by this fraction of its largest value in the shape sin(pi x / L), so
         that the linear phase starts from a known small amplitude; default from rest.
+    trackers : sequence of Tracker, optional
+        More trackers for the run (a :class:`~beltsim.simulation.trackers.SnapshotTracker`
+        for an animation), called at every check after the flutter's own.
 
     Returns
     -------
@@ -181,7 +184,7 @@ def flutter_run(scene, t_end: float, elements: int | None = None,
     log = FlutterLog(probe if probe is not None else 0.5 * (P.x2 + P.L),
                      float(steady.fnode.sum()))
     start = time.perf_counter()
-    res = sim.run(raise_on_failure=False, trackers=[log])
+    res = sim.run(raise_on_failure=False, trackers=[log, *trackers])
     wall = time.perf_counter() - start
     return Flutter(scene=sc, elements=sim.grid.n_elements, step=sim.scheme.max_step,
                    steady_friction=log.steady, t=np.array(log.t),
