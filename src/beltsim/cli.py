@@ -435,12 +435,16 @@ def cmd_modes(args):
     from pathlib import Path
 
     from .api import modes
+    from .cli_map import removing_damping
     from .io.files import prepare_outdir, write_json
 
-    found = modes(_scene(args), count=args.count, f_max=args.f_max, elements=args.elements)
+    scene = _scene(args)
+    found = modes(scene, count=args.count, f_max=args.f_max, elements=args.elements)
     out = prepare_outdir(args.out or Path("runs/out") / f"modes_{Path(args.scene).stem}")
     write_json(out / "modes.json", found.to_list())
     print(found.table())
+    if found.least_stable.real > 0.0:
+        print(removing_damping(scene, found.elements), flush=True)
     print(f"wrote {out / 'modes.json'}")
     return 0
 

@@ -63,6 +63,23 @@ def cmd_stability_map(args):
     return 1 if missing else 0
 
 
+def removing_damping(scene, elements: int) -> str:
+    """What ``beltsim modes`` says when the least stable mode grows: the damping d at
+    which the drive's least stable mode decays (the stability map's critical damping of
+    the central form's estimate on the modes' grid), or why there is none."""
+    from .studies import stability_map as study
+
+    on_grid = scene.with_overrides({"numerics.elements": elements})
+    crit = study.critical_damping(on_grid)
+    if crit.damping is None or crit.lower is None:
+        return f"a mode grows; the damping that removes it: {crit.describe()}"
+    at = {r["value"]: r for r in crit.evaluations}[crit.damping]
+    return (f"a mode grows; physics.damping = {crit.damping:.4g} 1/s removes it (the "
+            f"least stable rate of the central form's estimate there: {at['rate']:+.3g} "
+            f"+- {at['error']:.2g} 1/s; at {crit.lower:.4g} 1/s it still grows; "
+            "beltsim stability-map SCENE --critical-damping)")
+
+
 def _band() -> float:
     from .simulation.stability import BAND_HZ
 
