@@ -92,7 +92,7 @@ def float_list(text, name):
 
 def map_header(param: str, unit: str) -> str:
     """The header of ``beltsim stability-map``'s table."""
-    return (f"{param + ' [' + unit + ']':>22s}  {'status':<15s}  {'rate [1/s]':>11s}  "
+    return (f"{param + ' [' + unit + ']':>24s}  {'status':<15s}  {'rate [1/s]':>11s}  "
             f"{'error [1/s]':>11s}  {'frequency [Hz]':>14s}  {'growing':>7s}  "
             f"{'wall [s]':>8s}")
 
@@ -100,7 +100,7 @@ def map_header(param: str, unit: str) -> str:
 def map_row(row: dict) -> str:
     """One point of a stability map as a line of its table (a point without a root: its
     status and why; an exact root: no error)."""
-    head = f"{row['value']:>22.6g}  {row['status']:<15s}  "
+    head = f"{row['value']:>24.6g}  {row['status']:<15s}  "
     wall = f"{row['wall_time']:>8.3g}" + (" (cached)" if row["cached"] else "")
     if row["rate"] is None:
         return head + f"{'':>11s}  {'':>11s}  {'':>14s}  {'':>7s}  {wall}  {row['reason']}"
