@@ -517,6 +517,12 @@ def solve(scene_or_params, model: str | None = None) -> AnalyticSolution:
     return _solved(P, model)
 
 
+def clear_cache() -> None:
+    """Forget the steady states solved so far (:func:`solve` keeps the last 64), so that
+    the next solve of each is done again."""
+    _solved.cache_clear()
+
+
 @functools.lru_cache(maxsize=64)
 def _solved(P: Params, model: str) -> AnalyticSolution:
     """One solve per physics: a run asks for its exact state up to three times (its
