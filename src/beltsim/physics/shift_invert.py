@@ -20,9 +20,10 @@ import scipy.sparse.linalg as spla
 
 #: Eigenvalues ARPACK finds about each shift of :func:`sweep`: more per shift means
 #: fewer shifts, but larger disks that find more of the damped eigenvalues left of the
-#: band (the accessory drive on 200 elements: 16 took 28 shifts and 1.2 s, 32 took 21
-#: shifts and 2.2 s, on two loaded cores)
-SWEEP_NEAREST = 16
+#: band, and restarts where a disk's edge cuts a dense cloud of them (the accessory drive
+#: on 200 elements, best of three on two loaded cores: 8, 10, 12, 14, 16 and 20 took
+#: 0.52, 0.54, 0.53, 0.57, 0.64 and 0.79 s)
+SWEEP_NEAREST = 12
 #: The sweep's shifts reach this many times the grid's highest axial frequency: above it
 #: every finite eigenvalue is damped by hundreds of 1/s at least (the belt's strain
 #: damping grows with the frequency; on the accessory drive none with Re > -100 1/s lies
