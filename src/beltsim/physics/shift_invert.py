@@ -33,9 +33,9 @@ SWEEP_REACH = 1.5
 ARPACK_TOL = 1e-10
 #: Two disks' eigenvalues closer than this times their distance to their shifts are one
 #: eigenvalue found twice. Measured on the accessory drive (60, 120 and 200 elements,
-#: tanh and exact laws) and drive_flat's sweeps: the copies of one eigenvalue at most
-#: 7.6e-6 apart (ARPACK's tolerance times the eigenvalue's condition), distinct ones
-#: found by one disk 1.0e-3 apart at least
+#: tanh and exact laws; 12 and 16 per shift) and drive_flat's sweeps: the copies of one
+#: eigenvalue at most 7.6e-6 apart (ARPACK's tolerance times the eigenvalue's
+#: condition), distinct ones found by one disk 1.0e-3 apart at least
 REPEAT = 1e-4
 
 
