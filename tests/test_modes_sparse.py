@@ -75,3 +75,52 @@ def test_the_sparse_search_lists_every_mode_below_a_frequency_bound():
     dense, sparse = _both("accessory", 60, f_max=3000.0)
     assert len(dense.modes) >= 5 and len(sparse.modes) == len(dense.modes)
     np.testing.assert_allclose(sparse.frequencies, dense.frequencies, rtol=BOUND)
+
+
+# -- the disks' bookkeeping ---------------------------------------------------------------
+
+
+@pytest.mark.unit
+def test_distinct_keeps_each_eigenvalue_once_and_a_double_one_twice():
+    """Two overlapping disks: a copy found by both (1e-9 apart) is kept once, the copy
+    nearer its shift with its mode; a double eigenvalue found twice by each disk is kept
+    twice; an eigenvalue 1e-2 of the distance from another (distinct) stays."""
+    from beltsim.physics.shift_invert import Disk, distinct
+
+    one, double, other = 10.0 + 100.0j, -5.0 + 130.0j, -5.0 + 131.0j
+    e = np.eye(4)
+    a = Disk(0j, 140.0, np.array([one, double, double]), e[:, :3].astype(complex))
+    b = Disk(120j, 30.0, np.array([one + 1e-9, double, double + 1e-12, other]), None)
+    lam, V = distinct([a, b])
+    assert lam.size == 4
+    np.testing.assert_allclose(np.sort_complex(lam), np.sort_complex([one, double, double,
+                                                                      other]), atol=1e-8)
+    # the copies of `one`: a's is 100.5 from its shift, b's 22.4 from its: b's is nearer,
+    # but a's has its mode
+    k = int(np.argmin(np.abs(lam - one)))
+    assert lam[k] == one and np.array_equal(V[:, k], e[:, 0])
+    assert np.isnan(V[:, int(np.argmin(np.abs(lam - other)))]).all()
+    # without modes the nearer copy wins
+    lam, _ = distinct([a.__class__(a.shift, a.radius, a.eigenvalues), b])
+    assert lam[int(np.argmin(np.abs(lam - one)))] == one + 1e-9
+
+
+@pytest.mark.unit
+def test_the_disks_cover_the_listed_cone_up_to_where_they_join():
+    """One disk about 0 of radius r covers the listed modes' cone (damping ratio below
+    MAX_DAMPING_RATIO = 0.5) up to r sqrt(1 - 0.5^2), as the disk's farthest point on
+    the cone's edge; a second disk about i w continues it where the two overlap, and a
+    gap stops it."""
+    from beltsim.physics.loop_modes import _complete
+    from beltsim.physics.shift_invert import Disk
+
+    r = 100.0
+    top = r * np.sqrt(0.75)
+    assert _complete([Disk(0j, r, np.zeros(1))]) == pytest.approx(top, rel=1e-14)
+    # about i w, radius R: t^2 y^2 + (y - w)^2 = R^2 at the top, t^2 = 1/3
+    w, R = 150.0, 90.0  # its lowest covered height, 69.4, lies below the first's top
+    y = (w + np.sqrt(4.0 / 3.0 * R * R - w * w / 3.0)) / (4.0 / 3.0)
+    assert (y / np.sqrt(3.0)) ** 2 + (y - w) ** 2 == pytest.approx(R * R, rel=1e-12)
+    both = _complete([Disk(w * 1j, R, np.zeros(1)), Disk(0j, r, np.zeros(1))])
+    assert both == pytest.approx(y, rel=1e-14)
+    assert _complete([Disk(0j, r, np.zeros(1)), Disk(400j, R, np.zeros(1))]) == top

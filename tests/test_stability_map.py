@@ -141,6 +141,7 @@ def test_a_drives_point_is_the_rightmost_eigenvalue_of_its_band(tmp_path, monkey
     central form has grid-scale eigenvalues (their frequency doubles with the grid) that
     the sweep leaves out by design."""
     from beltsim.physics import modes
+    from beltsim.physics.shift_invert import SWEEP_REACH
     from beltsim.solvers.linearise import highest_frequency
 
     monkeypatch.setenv("BELTSIM_CACHE_DIR", str(tmp_path))
@@ -150,7 +151,7 @@ def test_a_drives_point_is_the_rightmost_eigenvalue_of_its_band(tmp_path, monkey
     disc, state = modes.steady_discretisation(
         scene.with_overrides({**key, "numerics.gyroscopic": "central"}))
     lam = modes.spectrum(disc, state)
-    band = lam[np.abs(lam.imag) <= modes.SWEEP_REACH * highest_frequency(disc)]
+    band = lam[np.abs(lam.imag) <= SWEEP_REACH * highest_frequency(disc)]
     top = band[np.argmax(band.real)]
     assert row["rate"] == pytest.approx(top.real, abs=1e-7 * abs(top))
     assert row["frequency"] == pytest.approx(abs(top.imag) / (2 * np.pi), rel=1e-7)

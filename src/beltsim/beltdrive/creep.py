@@ -325,17 +325,21 @@ class SerpentineSolution:
         """Per pulley: the load at which its slip arc reaches its wrap over its load (the
         others' loads held); for the driver the factor on all loads. inf at idlers and
         with perfect adhesion. Computed on first use (a root search per loaded pulley)."""
-        if "margins" not in self._cache:
-            n = len(self.layout)
-            out = np.full(n, math.inf)
+        return np.array([self.slip_margin(i) for i in range(len(self.layout))])
+
+    def slip_margin(self, i: int) -> float:
+        """Pulley i's entry of :attr:`slip_margins`, its root search alone (a start-up's
+        ramp needs only the driver's: a fifth of the accessory drive's searches)."""
+        key = ("margin", i)
+        if key not in self._cache:
+            out = math.inf
             if self.data.mu is not None:
-                for i in range(n):
-                    if i == self.data.driver and sum(self.data.loads) > 0:
-                        out[i] = _load_factor(self.data, self.layout, i, True)
-                    elif self.data.loads[i] > 0:
-                        out[i] = _load_factor(self.data, self.layout, i, False)
-            self._cache["margins"] = out
-        return self._cache["margins"]
+                if i == self.data.driver and sum(self.data.loads) > 0:
+                    out = _load_factor(self.data, self.layout, i, True)
+                elif self.data.loads[i] > 0:
+                    out = _load_factor(self.data, self.layout, i, False)
+            self._cache[key] = out
+        return self._cache[key]
 
     @property
     def alpha_offset(self) -> float | None:

@@ -35,16 +35,8 @@ import numpy as np
 
 from ..errors import SceneError, UsageError
 from .arm import element_stretches
-from .modes import (
-    INFINITE,
-    SWEEP_REACH,
-    ShiftInvert,
-    eigenpairs,
-    linearisation,
-    one_blas_thread,
-    rightmost,
-    steady_discretisation,
-)
+from .modes import INFINITE, eigenpairs, linearisation, steady_discretisation
+from .shift_invert import SWEEP_REACH, ShiftInvert, distinct, one_blas_thread, sweep
 
 #: The grid when the scene sets none
 DEFAULT_ELEMENTS = 200
@@ -56,8 +48,8 @@ MAX_ELEMENTS = 3200
 DENSE_ELEMENTS = 40
 #: The dense method refuses grids beyond this (minutes and gigabytes)
 MAX_DENSE_ELEMENTS = 800
-#: Eigenvalues about 0 the sparse search asks for first (doubled until the listed modes
-#: are complete)
+#: Eigenvalues about 0 the sparse search asks for first when the sweep's disks hold too
+#: few of the listed modes (doubled until the listing is complete)
 FIRST_NEAREST = 48
 #: Modes listed when neither a count nor a frequency bound is given
 DEFAULT_COUNT = 10
@@ -134,8 +126,7 @@ class DriveModes:
         The grid's elements.
     eigenvalues : int
         How many eigenvalues were computed: the dense method's every finite one; the
-        sparse method's those its shifts found (a few counted twice where the disks
-        overlap).
+        sparse method's distinct ones its shifts found.
     method : str
         "dense" or "sparse" (:func:`drive_modes`).
     """
@@ -201,11 +192,12 @@ def drive_modes(scene, count: int | None = None, f_max: float | None = None,
 
     Two methods give the same modes and least stable eigenvalue (the tests compare them):
     "dense", every eigenvalue by the QZ algorithm (small grids), and "sparse", ARPACK in
-    shift-invert mode: about 0 for the listed modes, the nearest eigenvalues asked for
-    doubling until the listing is complete (a mode missing from the disk of radius r
-    about 0 has abs(lambda) > r, so every listed mode with Im lambda below
-    r sqrt(1 - MAX_DAMPING_RATIO^2) has been found), then a sweep up the imaginary axis
-    for the least stable eigenvalue (:func:`beltsim.physics.modes.rightmost`).
+    shift-invert mode: a sweep of shifts up the imaginary axis for the least stable
+    eigenvalue (:func:`beltsim.physics.shift_invert.sweep`), whose disks also hold the
+    listed modes up to a height (:func:`_complete`: a mode missing from the disk of
+    radius r about 0 has abs(lambda) > r, so every listed mode with Im lambda below
+    r sqrt(1 - MAX_DAMPING_RATIO^2) has been found, and so on for each disk), and when
+    that is too low, more eigenvalues about 0, doubling until the listing is complete.
 
     Parameters
     ----------
@@ -276,38 +268,75 @@ def _listed(lam, count, f_max, below=math.inf):
 
 def _sparse(disc, state, count, f_max):
     """(eigenvalues, their modes z as columns, the least stable eigenvalue, how many
-    eigenvalues were found) by shift-invert; see :func:`drive_modes`."""
+    distinct eigenvalues were found) by shift-invert; see :func:`drive_modes`."""
     from ..solvers.linearise import highest_frequency
 
     M, C, K = linearisation(disc, state)
-    size = 2 * K.shape[0]
-    cone = math.sqrt(1.0 - MAX_DAMPING_RATIO ** 2)
-    k = FIRST_NEAREST
+    n, size = K.shape[0], 2 * K.shape[0]
+    top = highest_frequency(disc)
     with one_blas_thread():
-        near = ShiftInvert(M, C, K, 0.0)
-        while True:
+        def listing(disks):
+            lam, V = distinct(disks)
+            below = _complete(disks)
+            return lam, V, below, _listed(lam, count, f_max, below)
+
+        done = []
+
+        def need_modes(disks):
+            # once the listing is complete no later disk adds a mode below its frequency
+            if not done:
+                _, _, below, order = listing(disks)
+                if _enough(order, count, f_max, below):
+                    done.append(len(disks))
+            return not done
+
+        disks = sweep(M, C, K, SWEEP_REACH * top, vectors=need_modes)
+        lam, V, below, order = listing(disks)
+        k = FIRST_NEAREST
+        # the sweep's disks hold too few of the listed modes: more about 0, doubling
+        while not _enough(order, count, f_max, below):
             k = min(k, size - 2)
-            lam, V = near.nearest(k, vectors=True)
-            radius = float(np.max(np.abs(lam)))
-            below = cone * radius  # every listed mode under this frequency is in lam
-            order = _listed(lam, count, f_max, below)
-            if ((count is not None and len(order) == count)
-                    or (f_max is not None and 2.0 * math.pi * f_max < below)):
-                break
-            if k == size - 2:  # every eigenvalue ARPACK can give: the dense path's job
+            disks.append(ShiftInvert(M, C, K, 0.0).disk(k, vectors=True))
+            lam, V, below, order = listing(disks)
+            if k == size - 2 and not _enough(order, count, f_max, below):
+                # every eigenvalue ARPACK can give: the dense path's job
                 lam, Z = eigenpairs(disc, state)
                 return lam, Z, complex(lam[np.argmax(lam.real)]), len(lam)
             k *= 2
-        n = K.shape[0]
-        keep = lam.imag < below
-        least, found = rightmost(M, C, K, SWEEP_REACH * highest_frequency(disc),
-                                 start=(lam, radius))
-        # as the dense path: beyond INFINITE times the grid's highest frequency an
-        # eigenvalue is an infinite one's round-off (ARPACK's Ritz values near 0)
-        finite = np.abs(found) < INFINITE * highest_frequency(disc)
-        least = complex(found[finite][np.argmax(found[finite].real)])
-        found = found[finite]
-    return lam[keep], V[:n, keep], least, len(found)
+    # as the dense path: beyond INFINITE times the grid's highest frequency an eigenvalue
+    # is an infinite one's round-off (ARPACK's Ritz values near 0)
+    finite = np.abs(lam) < INFINITE * top
+    least = complex(lam[finite][np.argmax(lam[finite].real)])
+    keep = lam.imag < below
+    return lam[keep], V[:n, keep], least, int(np.count_nonzero(finite))
+
+
+def _enough(order, count, f_max, below) -> bool:
+    """Whether the listing is complete: ``count`` modes, or every one up to f_max."""
+    return ((count is not None and len(order) == count)
+            or (f_max is not None and 2.0 * math.pi * f_max < below))
+
+
+def _complete(disks) -> float:
+    """The frequency (rad/s) below which the disks hold every mode that is listed by its
+    damping ratio: the disks about i w of radius r cover the cone
+    abs(Re lambda) <= t Im lambda, t = zeta / sqrt(1 - zeta^2) (zeta
+    MAX_DAMPING_RATIO), where t^2 y^2 + (y - w)^2 <= r^2, y = Im lambda, and the
+    covered heights from 0 up join."""
+    t2 = MAX_DAMPING_RATIO ** 2 / (1.0 - MAX_DAMPING_RATIO ** 2)
+    spans = []
+    for d in disks:
+        w, r = d.shift.imag, d.radius
+        root = (1.0 + t2) * r * r - t2 * w * w
+        if root >= 0.0:
+            spans.append(((w - math.sqrt(root)) / (1.0 + t2),
+                          (w + math.sqrt(root)) / (1.0 + t2)))
+    below = 0.0
+    for lo, hi in sorted(spans):
+        if lo > below:
+            break
+        below = max(below, hi)
+    return below
 
 
 def _mode(disc, lam, z, samples) -> Mode:

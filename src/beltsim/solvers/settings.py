@@ -336,7 +336,7 @@ def inertial_ramp(scene) -> float:
 
             margin = capacity(P) / P.M2 if P.M2 > 0 else math.inf
         else:
-            margin = float(sol.slip_margins[P.driver])
+            margin = float(sol.slip_margin(P.driver))
     except NoSolutionError:
         return 0.0
     rd = P.pulleys[P.driver].radius
