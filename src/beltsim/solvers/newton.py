@@ -17,19 +17,18 @@ import numpy as np
 from numba import njit
 
 from ..errors import FailureKind, NumericalError
-from ..physics.friction import EXACT, is_exact, law, law_inverse
+from ..physics.friction import EXACT, is_exact
 from ..physics.model import (
     JACOBIAN,
-    LAM_MAX,
     add_stick_penalty,
     assemble,
     bound_scale,
     loop_speed,
-    update_multipliers,
 )
 from ..problem.drive import friction_factor
 from .base import Scheme
 from .border import Border, block_substitute_many, finish, gather, schur
+from .dual import release_stuck_ratios, update_multipliers
 from .ssn import Saddle, project, saddle_solve, saddle_system
 
 # status codes of the time-stepping kernels that solve with Newton
@@ -55,13 +54,6 @@ MAX_HALVINGS = 8
 # bordered factorisation is half of an iteration's cost. A slower contraction, or a
 # growing update, factorises again.
 CHORD = 0.2
-# A friction ratio with slope dlam/ds below NEAR_BOUND (|lam| > 0.995 for tanh) that
-# differs from the law at its slip velocity by more than LAW_GAP is stuck at the bound;
-# while Newton's updates grow, one whose g^-1(lam) lies beyond that slip velocity (over
-# v_reg) by more than SLIP_GAP
-NEAR_BOUND = 1e-2
-LAW_GAP = 1e-3
-SLIP_GAP = 0.1
 
 #: Counters a scheme accumulates, one record the kernels update in place.
 STATS_DTYPE = np.dtype([("newton_iterations", np.int64), ("failed_steps", np.int64),
@@ -273,40 +265,6 @@ def friction_forces(lam, fnode, u, g, t, mesh, p, drive):
     for j in mesh.cn:
         S, _, _ = bound_scale(mesh.seg[j], j, u, c, fs, mesh, p)
         fnode[j] = -mesh.wf[j] * S * lam[j]
-
-
-@njit(cache=True, no_cpython_wrapper=True)
-def release_stuck_ratios(lam, w, mesh, code, growing):
-    """Restart the friction ratios stuck near +-1 against their slip velocity; returns
-    the largest change (0: none).
-
-    Near the bound the dual update sg (rl + ...) is tiny (slope sg = 1 - lam^2 for tanh)
-    even when the slip velocity has turned: a node leaving the slip at a stick
-    transition stays at lam = -1 with v_rel / v_reg = +50, and the updates pass every
-    convergence test. At convergence, such a ratio (sg below NEAR_BOUND, off
-    g(v_rel / v_reg) of the iterate before the update by more than LAW_GAP) is not
-    converged: it restarts from 0, where the slope is largest (from the bound the update
-    grows only by a factor 1 + 2 abs(rl) per iteration), and Newton goes on. While the
-    updates grow (``growing``: a ratio the fraction-to-the-boundary rule took near the
-    bound coming back, some ten iterations), a ratio whose g^-1(lam) lies beyond that
-    slip velocity by more than SLIP_GAP is set to the law's value there instead.
-    """
-    big = 0.0
-    for j in mesh.cn:
-        if w.sg[j] < NEAR_BOUND and lam[j] * w.rl[j] < 0.0:
-            s = w.rl[j] + law_inverse(code, w.lam0[j])[0]
-            g = law(code, s)[0]
-            if growing:
-                if abs(law_inverse(code, lam[j])[0] - s) <= SLIP_GAP:
-                    continue
-                g = min(LAM_MAX, max(-LAM_MAX, g))
-            elif abs(g - lam[j]) > LAW_GAP:
-                g = 0.0
-            else:
-                continue
-            big = max(big, abs(g - lam[j]))
-            lam[j] = g
-    return big
 
 
 @njit(cache=True, inline="always")
