@@ -4,9 +4,10 @@ The same formulation and the same steps as :mod:`beltsim.solvers.implicit`: vari
 step BDF2 on the system in (u, u_t), one primal-dual Newton solve per step with the
 friction ratios condensed node by node (:func:`beltsim.solvers.newton.newton`, its
 convergence tests, its chord steps, the fraction-to-the-boundary update of the ratios,
-the law's value near the bound and the restart of ratios stuck there), the Hairer-Wanner filtered local error estimate with
-the step's Newton matrix, the same step control, steps landing on the controller's
-checks, the same power integrals. Only the implementation differs:
+the law's value near the bound and the restart of ratios stuck there), the
+Hairer-Wanner filtered local error estimate with the step's Newton matrix, the same
+step control, steps landing on the controller's checks, the same power integrals. Only
+the implementation differs:
 
 * the residual and the Jacobian of :func:`beltsim.physics.model.assemble` are built
   with numpy array operations over all nodes at once;

@@ -29,7 +29,7 @@ from ..problem.drive import friction_factor
 from .base import Scheme
 from .border import Border, block_substitute_many, finish, gather, schur
 from .dual import release_stuck_ratios, update_multipliers
-from .ssn import Saddle, project, saddle_solve, saddle_system
+from .ssn import Saddle, project, saddle_factorise, saddle_resolve, saddle_system
 
 # status codes of the time-stepping kernels that solve with Newton
 OK, FAILED, NONFINITE = 0, 1, 2
@@ -61,10 +61,13 @@ STATS_DTYPE = np.dtype([("newton_iterations", np.int64), ("failed_steps", np.int
 
 
 class NewtonSettings(NamedTuple):
-    """Newton's stopping rule: the tolerance and the most iterations."""
+    """Newton's stopping rule: the tolerance and the most iterations; and whether the
+    caller needs the factors of the converged Jacobian (an error estimate's)."""
 
     tol: float  # scaled max norm of the update
     max_iterations: int
+    # False: an exact law's solve skips the factorisation it would leave for the caller
+    factors: bool = True
 
 
 class Workspace(NamedTuple):
@@ -421,7 +424,12 @@ def newton_exact(s, state, old, inv_dt, t, mesh, p, drive, loads, scales, settin
     and be read as stuck or sliding by round-off.
     On return, w holds the block LU of the 2x2 Jacobian with the stuck nodes' slope
     f_s AUGMENTATION / v_aug, the default regularisation's (a penalty standing in for
-    their constraint), for the step's error estimate, as :func:`newton` leaves its own.
+    their constraint), for the step's error estimate, as :func:`newton` leaves its own
+    (unless settings.factors is False: an ESDIRK scheme's stages before the last).
+    While the stick/slip pattern holds, an iteration after one whose update shrank by
+    CHORD or more (or after the first) keeps the factors (a chord step): the factorisation
+    with the border's columns is most of an iteration's cost, and with the pattern fixed
+    the Jacobian changes only through the bounds S(u_x, c) and the belt speed.
 
     A regularised law's workspace has no such system (``s`` None) and never comes here;
     its type prunes the body, so a regularised scene compiles none of the exact laws'
@@ -440,11 +448,13 @@ def newton_exact(s, state, old, inv_dt, t, mesh, p, drive, loads, scales, settin
     assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)
     saddle_system(lam, loop_speed(g, mesh, p), inv_dt, fs, mesh, p, w, s)
     previous = np.inf
+    reuse = False
     for it in range(settings.max_iterations):
         st.newton_iterations += 1
-        if not saddle_solve(s, mesh):
+        if not reuse and not saddle_factorise(s, mesh):
             st.merit = merit(w.R, w.Rg, scales)
             return False
+        saddle_resolve(s, mesh)
         step = update_size(s.dx, s.dg, scales)
         dlam = 0.0
         for i in range(n):
@@ -473,10 +483,14 @@ def newton_exact(s, state, old, inv_dt, t, mesh, p, drive, loads, scales, settin
         # floor ends the iteration whatever the pattern did
         settled = changed == 0 or merit(w.R, w.Rg, scales) < ROUNDOFF_MERIT * (n + ng)
         done = settled and update_converged(update, previous, it, tol)
+        # a chord step next while the stick/slip pattern holds and the updates shrink
+        reuse = changed == 0 and alpha == 1.0 and (it == 0 or update < CHORD * previous)
         previous = update
         if done:
             project(lam, mesh, p.law)  # the sliding ratios, off +-1 by round-off
             friction_forces(lam, fnode, u, g, t, mesh, p, drive)
+            if not settings.factors:
+                return True
             add_stick_penalty(w, inv_dt, fs, loop_speed(g, mesh, p), mesh, p)
             return factorise(w, mesh)
     st.merit = merit(w.R, w.Rg, scales)
