@@ -426,10 +426,11 @@ def newton_exact(s, state, old, inv_dt, t, mesh, p, drive, loads, scales, settin
     f_s AUGMENTATION / v_aug, the default regularisation's (a penalty standing in for
     their constraint), for the step's error estimate, as :func:`newton` leaves its own
     (unless settings.factors is False: an ESDIRK scheme's stages before the last).
-    While the stick/slip pattern holds, an iteration after one whose update shrank by
-    CHORD or more (or after the first) keeps the factors (a chord step): the factorisation
-    with the border's columns is most of an iteration's cost, and with the pattern fixed
-    the Jacobian changes only through the bounds S(u_x, c) and the belt speed.
+    While the stick/slip pattern holds, an iteration of a time step (inv_dt > 0) after
+    one whose update shrank by CHORD or more (or after the first) keeps the factors (a
+    chord step): the factorisation with the border's columns is most of an iteration's
+    cost, and with the pattern fixed the Jacobian changes only through the bounds
+    S(u_x, c) and the belt speed.
 
     A regularised law's workspace has no such system (``s`` None) and never comes here;
     its type prunes the body, so a regularised scene compiles none of the exact laws'
@@ -483,8 +484,11 @@ def newton_exact(s, state, old, inv_dt, t, mesh, p, drive, loads, scales, settin
         # floor ends the iteration whatever the pattern did
         settled = changed == 0 or merit(w.R, w.Rg, scales) < ROUNDOFF_MERIT * (n + ng)
         done = settled and update_converged(update, previous, it, tol)
-        # a chord step next while the stick/slip pattern holds and the updates shrink
-        reuse = changed == 0 and alpha == 1.0 and (it == 0 or update < CHORD * previous)
+        # a chord step next while the stick/slip pattern holds and the updates shrink; not
+        # at steady state (inv_dt = 0), whose solve is the reference the runs are held to,
+        # converged quadratically to round-off
+        reuse = (inv_dt > 0.0 and changed == 0 and alpha == 1.0
+                 and (it == 0 or update < CHORD * previous))
         previous = update
         if done:
             project(lam, mesh, p.law)  # the sliding ratios, off +-1 by round-off
