@@ -3,10 +3,11 @@
 The same formulation and the same steps as :mod:`beltsim.solvers.implicit`: variable-
 step BDF2 on the system in (u, u_t), one primal-dual Newton solve per step with the
 friction ratios condensed node by node (:func:`beltsim.solvers.newton.newton`, its
-convergence tests, the fraction-to-the-boundary update of the ratios and the restart
-of ratios stuck at the bound), the Hairer-Wanner filtered local error estimate with
-the step's Newton matrix, the same step control, steps landing on the controller's
-checks, the same power integrals. Only the implementation differs:
+convergence tests, its chord steps, the fraction-to-the-boundary update of the ratios,
+the law's value near the bound and the restart of ratios stuck there), the
+Hairer-Wanner filtered local error estimate with the step's Newton matrix, the same
+step control, steps landing on the controller's checks, the same power integrals. Only
+the implementation differs:
 
 * the residual and the Jacobian of :func:`beltsim.physics.model.assemble` are built
   with numpy array operations over all nodes at once;
@@ -42,6 +43,7 @@ from beltsim.physics.friction import SQRT, TANH, law_inverse_numpy, law_numpy
 from beltsim.physics.model import LAM_MAX, POWER_TERMS
 from beltsim.simulation.controller import Simulation
 from beltsim.solvers.base import Scheme
+from beltsim.solvers.dual import LAW_GAP, NEAR_BOUND, SLIP_GAP
 from beltsim.solvers.implicit import (
     BDF2_ERROR,
     MAX_GROWTH,
@@ -50,13 +52,7 @@ from beltsim.solvers.implicit import (
     SAFETY,
     ImplicitScheme,
 )
-from beltsim.solvers.newton import (
-    CONTRACTION,
-    LAW_GAP,
-    NEAR_BOUND,
-    ROUNDOFF_FLOOR,
-    SLIP_GAP,
-)
+from beltsim.solvers.newton import CHORD, CONTRACTION, ROUNDOFF_FLOOR
 
 from .peers import FixedPattern, coo_parts
 
@@ -180,7 +176,7 @@ class PortScheme(Scheme):
         return None if info != 0 else BandedLU(lu, piv, kl, ku)
 
     def update_multipliers(self, lam, dx, inv_dt, asm):
-        """Vectorised :func:`beltsim.physics.model.update_multipliers`; the largest change."""
+        """Vectorised :func:`beltsim.solvers.dual.update_multipliers`; the largest change."""
         d = self.disc
         p, jc = d.model, self.jc
         du, dth = np.zeros(self.N + 1), np.zeros(self.N + 1)
@@ -191,11 +187,24 @@ class PortScheme(Scheme):
         dl = asm.sg * (asm.rl + dv / p.regularisation)
         dl = np.where(lj + dl >= 1.0, 0.99 * (1.0 - lj),
                       np.where(lj + dl <= -1.0, -0.99 * (1.0 + lj), dl))
-        lam[jc] = np.minimum(LAM_MAX, np.maximum(-LAM_MAX, lj + dl))
+        new = np.minimum(LAM_MAX, np.maximum(-LAM_MAX, lj + dl))
+        # near the bound, the law at the linearised slip velocity on the same side
+        near = 1.0 < NEAR_BOUND * law_inverse_numpy(code := p.law, new)[1]
+        if near.any():
+            s = law_inverse_numpy(code, lj)[0] + asm.rl + dv / p.regularisation
+            if code == TANH:  # the kernel's formula (friction.law), to the bit
+                e = np.exp(-2.0 * np.abs(s))
+                gs = np.copysign((1.0 - e) / (1.0 + e), s)
+            else:
+                gs = law_numpy(code, s)[0]
+            primal = near & (new * (gs - new) < 0.0) & (gs * new > 0.0)
+            new = np.where(primal, np.minimum(LAM_MAX, np.maximum(-LAM_MAX, gs)), new)
+        dl = new - lj
+        lam[jc] = new
         return float(np.abs(dl).max()) if dl.size else 0.0
 
     def release_stuck_ratios(self, lam, lam0, asm, growing):
-        """Vectorised :func:`beltsim.solvers.newton.release_stuck_ratios`: the largest
+        """Vectorised :func:`beltsim.solvers.dual.release_stuck_ratios`: the largest
         change."""
         jc, code = self.jc, self.disc.model.law
         lj = lam[jc]
@@ -227,13 +236,15 @@ class PortScheme(Scheme):
             self.lu, self.kf = self.factorise(asm.J), asm.k
             return self.lu is not None
         previous = math.inf
+        reuse = False
         for it in range(max_it):
             self.newton_iterations += 1
-            lu = self.factorise(asm.J)
-            if lu is None:
-                return False
-            self.lu, self.kf = lu, asm.k
-            dx = lu.solve(-asm.R.reshape(-1)).reshape(-1, 2)
+            if not reuse:
+                lu = self.factorise(asm.J)
+                if lu is None:
+                    return False
+                self.lu, self.kf = lu, asm.k
+            dx = self.lu.solve(-asm.R.reshape(-1)).reshape(-1, 2)
             step = max(np.abs(dx[:, 0]).max() / sc.u, np.abs(dx[:, 1]).max() / sc.theta)
             if not math.isfinite(step):
                 return False
@@ -257,6 +268,7 @@ class PortScheme(Scheme):
                 fnode[:] = reference.friction(vrel, t, d.mesh, d.model, d.drive, lam)[0]
                 return True
             asm = self.assemble(u, th, lam, fnode, old, inv_dt, t)
+            reuse = it >= 1 and update < CHORD * previous  # the kernel's chord step
             previous = update
         return False
 

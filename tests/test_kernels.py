@@ -23,11 +23,11 @@ from beltsim.physics.model import (
     assemble,
     power_terms,
     rate_part,
-    update_multipliers,
 )
 from beltsim.problem.drive import friction_factor, ramp
 from beltsim.problem.scene import Scene
 from beltsim.solvers import Discretisation
+from beltsim.solvers.dual import update_multipliers
 from beltsim.solvers.newton import (
     NewtonSettings,
     Workspace,
@@ -350,6 +350,31 @@ def test_update_multipliers_stays_inside_and_follows_linearisation():
     rl[contact] = 0.1
     update_multipliers(lam, dx, np.zeros(0), 0.0, p.speed, d.mesh, p, w)
     np.testing.assert_allclose(lam[contact], 0.075)
+
+
+def test_update_multipliers_takes_the_law_near_the_bound():
+    """A ratio the dual update leaves near the bound takes the law at its linearised slip
+    velocity when that lies on its side of zero, nearer zero; else the dual update."""
+    d, grid, p = _setup(N=20, dual=1)
+    assert p.law == TANH
+    w = Workspace.allocate(grid.n_elements)
+    lam = np.zeros(len(grid.x))
+    contact = slice(d.mesh.c0, grid.j2 + 1)
+    dx = np.zeros((grid.n_elements - 1, 2))
+    start = 0.99999
+    dual_slope = 1.0 - start**2
+    for s, expected in ((1.0, np.tanh(1.0)),  # slowed down: the law
+                        (-1.0, None),  # turned round: the dual update
+                        (20.0, None)):  # deeper in slip: the dual update
+        lam[contact] = start
+        w.sg[contact] = dual_slope
+        w.rl[contact] = s - np.arctanh(start)
+        dual = start + dual_slope * (s - np.arctanh(start))
+        dual = min(dual, start + 0.99 * (1.0 - start))
+        big = update_multipliers(lam, dx, np.zeros(0), 0.0, p.speed, d.mesh, p, w)
+        want = dual if expected is None else expected
+        np.testing.assert_allclose(lam[contact], want, rtol=1e-12)
+        assert big == pytest.approx(abs(want - start), rel=1e-9)
 
 
 def test_ramp_is_smooth_and_monotone():

@@ -177,7 +177,8 @@ def assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, wan
     it is an unknown with the equation rl = v_rel / v_reg - g^{-1}(lam) = 0,
     condensed node by node into the (u, theta) rows so the Jacobian keeps its
     block band (two lower block bands from the friction stencil, one upper). w.sg
-    receives the slope dlam/d(v_rel / v_reg) used by :func:`update_multipliers`.
+    receives the slope dlam/d(v_rel / v_reg) used by
+    :func:`beltsim.solvers.dual.update_multipliers`.
 
     The exact laws (friction.EXACT, ADHESION; p.regularisation is then the
     augmentation velocity v_aug) keep lam as a full unknown of a semi-smooth Newton
@@ -477,43 +478,6 @@ def add_friction_slope(L2, Lb, Db, i, j, k, inv_dt, c, hh, sw):
         blk[i, 0, 1] += dd * hh
         blk[i, 1, 0] += dd * hh
         blk[i, 1, 1] += dd * hh * hh
-
-
-@njit(cache=True)
-def update_multipliers(lam, dx, dg, inv_dt, c, mesh, p, w):
-    """Newton update of the friction ratios after the condensed solve (dx the rows'
-    update, dg the globals'; c the belt speed of the assembly).
-
-    Each lam moves at most 99% of the way to the boundary of (-1, 1) (fraction to
-    the boundary) and stays within LAM_MAX of it, so g^{-1}(lam) stays finite.
-    Returns the largest change.
-    """
-    hh = p.half_height
-    rl, sg, sw = w.rl, w.sg, mesh.sw
-    off = mesh.off
-    nn = sw.shape[0]
-    big = 0.0
-    for j in mesh.cn:
-        dvrel = 0.0
-        for o in range(3):
-            k = wrap(j - 2 + o, nn)
-            if k >= off:
-                dvrel += (slip_velocity_slope(sw, j, o, c, inv_dt)
-                          * (dx[k - off, 0] + hh * mesh.face[j] * dx[k - off, 1]))
-        if off == 0:
-            dvrel += w.vc[j] * dg[0]
-            K = mesh.seg_speed[mesh.seg[j]]
-            if K >= 1:
-                dvrel -= mesh.seg_radius[mesh.seg[j]] * dg[K]
-        dl = sg[j] * (rl[j] + dvrel / p.regularisation)
-        if lam[j] + dl >= 1.0:
-            dl = 0.99 * (1.0 - lam[j])
-        elif lam[j] + dl <= -1.0:
-            dl = -0.99 * (1.0 + lam[j])
-        lam[j] = min(LAM_MAX, max(-LAM_MAX, lam[j] + dl))
-        if abs(dl) > big:
-            big = abs(dl)
-    return big
 
 
 def traction(fnode, wf):

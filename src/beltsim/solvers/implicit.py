@@ -126,7 +126,7 @@ def predict_friction(lam, lam_prev, r, mesh, code):
     Kept inside the bounds of the primal-dual iteration (+-LAM_MAX): a node that
     reaches slip in the step starts there, and one that the extrapolation takes to
     the bound wrongly is caught by Newton's check of the ratios at the bound
-    (:func:`beltsim.solvers.newton.release_stuck_ratios`). The exact laws take the
+    (:func:`beltsim.solvers.dual.release_stuck_ratios`). The exact laws take the
     extrapolation as it is: a Coulomb ratio beyond +-1 starts the semi-smooth Newton
     with the node sliding (its first update puts it on the bound), which saves
     iterations where the slip front moves fast.

@@ -17,20 +17,19 @@ import numpy as np
 from numba import njit
 
 from ..errors import FailureKind, NumericalError
-from ..physics.friction import EXACT, is_exact, law, law_inverse
+from ..physics.friction import EXACT, is_exact
 from ..physics.model import (
     JACOBIAN,
-    LAM_MAX,
     add_stick_penalty,
     assemble,
     bound_scale,
     loop_speed,
-    update_multipliers,
 )
 from ..problem.drive import friction_factor
 from .base import Scheme
 from .border import Border, block_substitute_many, finish, gather, schur
-from .ssn import Saddle, project, saddle_solve, saddle_system
+from .dual import release_stuck_ratios, update_multipliers
+from .ssn import Saddle, project, saddle_factorise, saddle_resolve, saddle_system
 
 # status codes of the time-stepping kernels that solve with Newton
 OK, FAILED, NONFINITE = 0, 1, 2
@@ -55,13 +54,6 @@ MAX_HALVINGS = 8
 # bordered factorisation is half of an iteration's cost. A slower contraction, or a
 # growing update, factorises again.
 CHORD = 0.2
-# A friction ratio with slope dlam/ds below NEAR_BOUND (|lam| > 0.995 for tanh) that
-# differs from the law at its slip velocity by more than LAW_GAP is stuck at the bound;
-# while Newton's updates grow, one whose g^-1(lam) lies beyond that slip velocity (over
-# v_reg) by more than SLIP_GAP
-NEAR_BOUND = 1e-2
-LAW_GAP = 1e-3
-SLIP_GAP = 0.1
 
 #: Counters a scheme accumulates, one record the kernels update in place.
 STATS_DTYPE = np.dtype([("newton_iterations", np.int64), ("failed_steps", np.int64),
@@ -69,10 +61,13 @@ STATS_DTYPE = np.dtype([("newton_iterations", np.int64), ("failed_steps", np.int
 
 
 class NewtonSettings(NamedTuple):
-    """Newton's stopping rule: the tolerance and the most iterations."""
+    """Newton's stopping rule: the tolerance and the most iterations; and whether the
+    caller needs the factors of the converged Jacobian (an error estimate's)."""
 
     tol: float  # scaled max norm of the update
     max_iterations: int
+    # False: an exact law's solve skips the factorisation it would leave for the caller
+    factors: bool = True
 
 
 class Workspace(NamedTuple):
@@ -275,40 +270,6 @@ def friction_forces(lam, fnode, u, g, t, mesh, p, drive):
         fnode[j] = -mesh.wf[j] * S * lam[j]
 
 
-@njit(cache=True, no_cpython_wrapper=True)
-def release_stuck_ratios(lam, w, mesh, code, growing):
-    """Restart the friction ratios stuck near +-1 against their slip velocity; returns
-    the largest change (0: none).
-
-    Near the bound the dual update sg (rl + ...) is tiny (slope sg = 1 - lam^2 for tanh)
-    even when the slip velocity has turned: a node leaving the slip at a stick
-    transition stays at lam = -1 with v_rel / v_reg = +50, and the updates pass every
-    convergence test. At convergence, such a ratio (sg below NEAR_BOUND, off
-    g(v_rel / v_reg) of the iterate before the update by more than LAW_GAP) is not
-    converged: it restarts from 0, where the slope is largest (from the bound the update
-    grows only by a factor 1 + 2 abs(rl) per iteration), and Newton goes on. While the
-    updates grow (``growing``: a ratio the fraction-to-the-boundary rule took near the
-    bound coming back, some ten iterations), a ratio whose g^-1(lam) lies beyond that
-    slip velocity by more than SLIP_GAP is set to the law's value there instead.
-    """
-    big = 0.0
-    for j in mesh.cn:
-        if w.sg[j] < NEAR_BOUND and lam[j] * w.rl[j] < 0.0:
-            s = w.rl[j] + law_inverse(code, w.lam0[j])[0]
-            g = law(code, s)[0]
-            if growing:
-                if abs(law_inverse(code, lam[j])[0] - s) <= SLIP_GAP:
-                    continue
-                g = min(LAM_MAX, max(-LAM_MAX, g))
-            elif abs(g - lam[j]) > LAW_GAP:
-                g = 0.0
-            else:
-                continue
-            big = max(big, abs(g - lam[j]))
-            lam[j] = g
-    return big
-
-
 @njit(cache=True, inline="always")
 def update_converged(update, previous, it, tol):
     """Newton's stopping rule on the size of an update (see :func:`newton`): below tol;
@@ -463,7 +424,13 @@ def newton_exact(s, state, old, inv_dt, t, mesh, p, drive, loads, scales, settin
     and be read as stuck or sliding by round-off.
     On return, w holds the block LU of the 2x2 Jacobian with the stuck nodes' slope
     f_s AUGMENTATION / v_aug, the default regularisation's (a penalty standing in for
-    their constraint), for the step's error estimate, as :func:`newton` leaves its own.
+    their constraint), for the step's error estimate, as :func:`newton` leaves its own
+    (unless settings.factors is False: an ESDIRK scheme's stages before the last).
+    While the stick/slip pattern holds, an iteration of a time step (inv_dt > 0) after
+    one whose update shrank by CHORD or more (or after the first) keeps the factors (a
+    chord step): the factorisation with the border's columns is most of an iteration's
+    cost, and with the pattern fixed the Jacobian changes only through the bounds
+    S(u_x, c) and the belt speed.
 
     A regularised law's workspace has no such system (``s`` None) and never comes here;
     its type prunes the body, so a regularised scene compiles none of the exact laws'
@@ -482,11 +449,13 @@ def newton_exact(s, state, old, inv_dt, t, mesh, p, drive, loads, scales, settin
     assemble(u, th, lam, g, fnode, old, inv_dt, t, mesh, p, drive, loads, w, JACOBIAN)
     saddle_system(lam, loop_speed(g, mesh, p), inv_dt, fs, mesh, p, w, s)
     previous = np.inf
+    reuse = False
     for it in range(settings.max_iterations):
         st.newton_iterations += 1
-        if not saddle_solve(s, mesh):
+        if not reuse and not saddle_factorise(s, mesh):
             st.merit = merit(w.R, w.Rg, scales)
             return False
+        saddle_resolve(s, mesh)
         step = update_size(s.dx, s.dg, scales)
         dlam = 0.0
         for i in range(n):
@@ -515,10 +484,17 @@ def newton_exact(s, state, old, inv_dt, t, mesh, p, drive, loads, scales, settin
         # floor ends the iteration whatever the pattern did
         settled = changed == 0 or merit(w.R, w.Rg, scales) < ROUNDOFF_MERIT * (n + ng)
         done = settled and update_converged(update, previous, it, tol)
+        # a chord step next while the stick/slip pattern holds and the updates shrink; not
+        # at steady state (inv_dt = 0), whose solve is the reference the runs are held to,
+        # converged quadratically to round-off
+        reuse = (inv_dt > 0.0 and changed == 0 and alpha == 1.0
+                 and (it == 0 or update < CHORD * previous))
         previous = update
         if done:
             project(lam, mesh, p.law)  # the sliding ratios, off +-1 by round-off
             friction_forces(lam, fnode, u, g, t, mesh, p, drive)
+            if not settings.factors:
+                return True
             add_stick_penalty(w, inv_dt, fs, loop_speed(g, mesh, p), mesh, p)
             return factorise(w, mesh)
     st.merit = merit(w.R, w.Rg, scales)

@@ -37,6 +37,7 @@ class Saddle(NamedTuple):
     C: np.ndarray  # inverse pivots
     W: np.ndarray  # multipliers of the first and second lower band
     W2: np.ndarray
+    U: np.ndarray  # the upper band factorised (saddle_system writes Ub anew)
     R: np.ndarray  # right-hand side (n, 3)
     dx: np.ndarray  # solution (n, 3)
     active: np.ndarray  # (nodes) 1 where the node sticks, at the last assembly
@@ -52,8 +53,8 @@ class Saddle(NamedTuple):
         """The arrays for ``n_rows`` rows (N - 1 open, N closed) and a loop's globals."""
         n, ng = max(n_rows, 0), n_globals
         z = np.zeros
-        return cls(z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)), z((n, 3, 3)),
-                   z((n, 3, 3)), z((n, 3, 3)), z((n, 3)), z((n, 3)), z(n + 2 - 2 * closed),
+        return cls(*(z((n, 3, 3)) for _ in range(8)), z((n, 3)), z((n, 3)),
+                   z(n + 2 - 2 * closed),
                    z((n, 3, ng)), z((ng, n, 3)), z((ng, ng)), z(ng), z(ng),
                    Border.allocate(n, 3, ng) if closed else None)
 
@@ -185,13 +186,15 @@ def saddle_factor(s, n):
     """Block LU of the first n rows of the 3x3 block-banded system (as
     newton.block_factor for 2x2 blocks): W2_i = L2_i S_{i-2}^{-1}, L'_i = L_i - W2_i
     U_{i-2}, W_i = L'_i S_{i-1}^{-1}, S_i = D_i - W_i U_{i-1}; s.C receives S_i^{-1}.
-    Returns False on a singular pivot."""
+    Returns False on a singular pivot. s.U receives a copy of the upper blocks, which
+    the substitutions read, so that the factors outlive the next :func:`saddle_system`."""
     Li = np.empty((1, 3, 3))
     S = np.empty((3, 3))
     for i in range(n):
         for r in range(3):
             for q in range(3):
                 S[r, q] = s.Db[i, r, q]
+                s.U[i, r, q] = s.Ub[i, r, q]
         if i > 0:
             for r in range(3):
                 for q in range(3):
@@ -226,7 +229,7 @@ def saddle_substitute(s, r, y):
             acc = y[i, a]
             if i < n - 1:
                 for b in range(3):
-                    acc -= s.Ub[i, a, b] * y[i + 1, b]
+                    acc -= s.U[i, a, b] * y[i + 1, b]
             z[a] = acc
         for a in range(3):
             y[i, a] = s.C[i, a, 0] * z[0] + s.C[i, a, 1] * z[1] + s.C[i, a, 2] * z[2]
@@ -256,7 +259,7 @@ def saddle_substitute_many(s, r, y):
                 acc = y[q, i, a]
                 if i < n - 1:
                     for b in range(3):
-                        acc -= s.Ub[i, a, b] * y[q, i + 1, b]
+                        acc -= s.U[i, a, b] * y[q, i + 1, b]
                 z[a] = acc
             for a in range(3):
                 y[q, i, a] = s.C[i, a, 0] * z[0] + s.C[i, a, 1] * z[1] + s.C[i, a, 2] * z[2]
@@ -266,18 +269,38 @@ def saddle_substitute_many(s, r, y):
 def saddle_solve(s, mesh):
     """Factorise the system (bordered on a loop) and solve it: s.dx (and s.dg) from s.R
     (and s.Rg). Returns False on a singular pivot."""
+    if not saddle_factorise(s, mesh):
+        return False
+    saddle_resolve(s, mesh)
+    return True
+
+
+@njit(cache=True)
+def saddle_factorise(s, mesh):
+    """Factorise the system (bordered on a loop) for :func:`saddle_resolve`. Returns False
+    on a singular pivot."""
     n = s.Db.shape[0]
     if mesh.off == 1:
-        if not saddle_factor(s, n):
-            return False
+        return saddle_factor(s, n)
+    return saddle_factor_bordered(s, s.border)
+
+
+@njit(cache=True)
+def saddle_resolve(s, mesh):
+    """s.dx (and s.dg) from s.R (and s.Rg) with the factors of :func:`saddle_factorise`,
+    which may be those of an earlier system (a chord step)."""
+    if mesh.off == 1:
         saddle_substitute(s, s.R, s.dx)
-        return True
-    return saddle_solve_bordered(s, s.border)
+        return
+    ni = s.Db.shape[0] - 2
+    saddle_substitute(s, s.R[:ni], s.dx[:ni])
+    finish(s.border, s.R, s.Rg, s.dx, s.dg)
 
 
 @njit(cache=True, no_cpython_wrapper=True)
-def saddle_solve_bordered(s, bd):
-    """A loop's part of :func:`saddle_solve`: the band without the border, then the border.
+def saddle_factor_bordered(s, bd):
+    """A loop's part of :func:`saddle_factorise`: the band without the border, then the
+    border's columns and Schur complement.
 
     An open layout's system has no border (``bd`` None) and never comes here; its type
     prunes the body, so an open layout compiles none of the border's kernels.
@@ -289,11 +312,7 @@ def saddle_solve_bordered(s, bd):
         return False
     gather(s.Lb, s.L2, s.Db, s.Ub, s.Gc, s.Gr, s.Gd, bd)
     saddle_substitute_many(s, bd.Bm, bd.X)
-    if not schur(bd):
-        return False
-    saddle_substitute(s, s.R[:ni], s.dx[:ni])
-    finish(bd, s.R, s.Rg, s.dx, s.dg)
-    return True
+    return schur(bd)
 
 
 @njit(cache=True, no_cpython_wrapper=True)
