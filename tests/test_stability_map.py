@@ -135,11 +135,12 @@ def test_a_drives_point_is_the_rightmost_eigenvalue_of_its_band(tmp_path, monkey
     of the central form on the scene's grid, for Im lambda up to SWEEP_REACH times the
     grid's highest axial frequency; here against every eigenvalue of that band by the QZ
     algorithm (dense) on that grid, with the value set by its own key. The two
-    eigen-solvers agree to 1e-7 abs(lambda): QZ is backward stable, and on these
-    non-normal pencils an eigenvalue's condition number (~1e8) lifts its round-off
-    (2e-16 of the pencil's norm) to about that (6e-4 1/s at 3.3 kHz). Above the band the
-    central form has grid-scale eigenvalues (their frequency doubles with the grid) that
-    the sweep leaves out by design."""
+    eigen-solvers agree to 5e-7 abs(lambda): QZ is backward stable, but on these
+    non-normal pencils an eigenvalue's condition number (~1e9) lifts its round-off (2e-16
+    of the pencil's norm) to about that; drive_flat's near-neutral mode at 3.3 kHz took
+    rates 0.0997 and 0.0969 1/s from QZ in two runs, 0.0991 from the sparse search in
+    both. Above the band the central form has grid-scale eigenvalues (their frequency
+    doubles with the grid) that the sweep leaves out by design."""
     from beltsim.physics import modes
     from beltsim.physics.shift_invert import SWEEP_REACH
     from beltsim.solvers.linearise import highest_frequency
@@ -153,7 +154,7 @@ def test_a_drives_point_is_the_rightmost_eigenvalue_of_its_band(tmp_path, monkey
     lam = modes.spectrum(disc, state)
     band = lam[np.abs(lam.imag) <= SWEEP_REACH * highest_frequency(disc)]
     top = band[np.argmax(band.real)]
-    assert row["rate"] == pytest.approx(top.real, abs=1e-7 * abs(top))
+    assert row["rate"] == pytest.approx(top.real, abs=5e-7 * abs(top))
     assert row["frequency"] == pytest.approx(abs(top.imag) / (2 * np.pi), rel=1e-7)
     assert row["error"] is not None and row["error"] >= 0.0
     if abs(row["rate"]) > row["error"]:
