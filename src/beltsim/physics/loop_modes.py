@@ -194,9 +194,9 @@ def drive_modes(scene, count: int | None = None, f_max: float | None = None,
     "dense", every eigenvalue by the QZ algorithm (small grids), and "sparse", ARPACK in
     shift-invert mode: a sweep of shifts up the imaginary axis for the least stable
     eigenvalue (:func:`beltsim.physics.shift_invert.sweep`), whose disks also hold the
-    listed modes up to a height (:func:`_complete`: a mode missing from the disk of
-    radius r about 0 has abs(lambda) > r, so every listed mode with Im lambda below
-    r sqrt(1 - MAX_DAMPING_RATIO^2) has been found, and so on for each disk), and when
+    listed modes up to a height (a mode missing from the disk of radius r about 0 has
+    abs(lambda) > r, so every listed mode with Im lambda below r sqrt(1 -
+    MAX_DAMPING_RATIO^2) has been found, and so on for each disk), and when
     that is too low, more eigenvalues about 0, doubling until the listing is complete.
 
     Parameters

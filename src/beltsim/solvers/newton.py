@@ -290,8 +290,9 @@ def newton(state, old, inv_dt, t, mesh, p, drive, loads, scales, settings, w):
     the round-off floor: below ROUNDOFF_FLOOR * tol and no longer halving. The floor
     grows with the condition number of the Jacobian, ~ (L / h_min)^2, and on very fine
     grids lies above a fixed tol. None of these counts while a friction ratio is stuck
-    at +-1 (:func:`release_stuck_ratios`). The primal-dual form keeps the last
-    factorisation for an iteration after an update that shrank by CHORD or more.
+    at +-1 (:func:`beltsim.solvers.dual.release_stuck_ratios`). The primal-dual form
+    keeps the last factorisation for an iteration after an update that shrank by CHORD
+    or more.
 
     On return, w holds the block LU of the Jacobian last factorised (block_factor)
     and the friction slopes it was assembled with (w.sgf), for the step's error
