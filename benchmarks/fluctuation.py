@@ -33,12 +33,13 @@ def fluctuating(scene, seconds=1.0, amplitude=AMPLITUDE, frequency=FREQUENCY, la
                 sets=()):
     """The scene with its driver's speed a sine about its own, run for ``seconds`` after
     its start-up ramp; with that ramp's end (s)."""
+    from beltsim.beltdrive.scene import driver_speed_key
     from beltsim.solvers import discretise
 
     P = scene.params
-    driver = P.pulleys[P.driver]
-    sine = {"mean": float(driver.speed), "amplitude": amplitude, "period": 1.0 / frequency}
-    s = scene.with_overrides([(f"pulley.{driver.name}.speed", sine),
+    sine = {"mean": float(P.pulleys[P.driver].speed), "amplitude": amplitude,
+            "period": 1.0 / frequency}
+    s = scene.with_overrides([(driver_speed_key(scene.to_dict()), sine),
                               ("numerics.friction_law", law),
                               ("numerics.steady_tol", 1e-300), *sets])
     settle = discretise(s).numerics.settle_time

@@ -123,6 +123,16 @@ def test_a_drives_parameters_set_their_keys(name, param, key):
     assert study.default_values(scene, param) == study.DRIVE_DEFAULT_VALUES[param]
 
 
+@pytest.mark.unit
+@pytest.mark.parametrize("name, key", [("drive_flat", "drive.driver_speed"),
+                                       ("serpentine_accessory", "pulley.crankshaft.speed")])
+def test_a_drivers_speed_given_as_a_table_is_not_mapped(name, key):
+    scene = beltsim.load_scene(name).with_overrides({key: [[0.0, 10.0], [0.2, 150.0]]})
+    with pytest.raises(UsageError, match="driver's speed must be a number"):
+        study.check_scene(scene, "driver_speed")
+    study.check_scene(scene, "damping")
+
+
 @pytest.mark.verification
 @pytest.mark.parametrize("name, param, value", [
     ("drive_flat", "damping", 5.0),

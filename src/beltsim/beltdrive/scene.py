@@ -47,7 +47,7 @@ from .pulley_tables import max_rim_speed as driver_rim_speed
 from .tensioner import TENSIONER_RULES, check_tensioner
 
 __all__ = ["MIN_SEGMENT_ELEMENTS", "OPTIONAL_SECTIONS", "REQUIRED", "SCHEMA", "DriveParams",
-           "DriveScene", "max_rim_speed", "set_key", "validate"]
+           "DriveScene", "driver_speed_key", "max_rim_speed", "set_key", "validate"]
 
 #: The fewest elements on each of the loop's four segments.
 MIN_SEGMENT_ELEMENTS = 4
@@ -187,8 +187,7 @@ def validate(data: dict) -> dict:
         P = params_of(out)
     except GeometryError as exc:
         raise SceneError(str(exc)) from None
-    speed_key = ("drive.driver_speed" if "pulley" not in out
-                 else f"pulley.{P.pulleys[P.driver].name}.speed")
+    speed_key = driver_speed_key(out)
     if P.rho > 0 and max_rim_speed(out) ** 2 * P.rho >= P.b1:
         raise SceneError(speed_key, f"the rim speed reaches the belt's critical "
                          f"speed sqrt(b1 / rho) = {math.sqrt(P.b1 / P.rho):.4g} m/s")
@@ -226,6 +225,14 @@ def set_key(data: dict, key: str, value) -> None:
         tables[names.index(parts[1])][parts[2]] = value
         return
     set_scene_key(data, key, value, SCHEMA, "a drive scene", known_keys=False)
+
+
+def driver_speed_key(data: dict) -> str:
+    """The key of the driver's speed in a drive scene's tables: ``drive.driver_speed`` in
+    the two-pulley shorthand, else ``pulley.NAME.speed`` of the pulley that has one."""
+    if "pulley" not in data:
+        return "drive.driver_speed"
+    return f"pulley.{next(t['name'] for t in data['pulley'] if 'speed' in t)}.speed"
 
 
 def max_rim_speed(data: dict) -> float:

@@ -124,7 +124,9 @@ def check_scene(scene, param: str) -> None:
         raise UsageError("stability-map: the scene must be inertial (physics.inertia = true) "
                          "and settle (no sine in its profiles)")
     if is_drive_scene(scene):
-        if param == "driver_speed" and not isinstance(_driver_speed(scene)[1], (int, float)):
+        P = scene.params
+        if param == "driver_speed" and not isinstance(P.pulleys[P.driver].speed,
+                                                      (int, float)):
             raise UsageError("--param driver_speed: the driver's speed must be a number "
                              "(ramped from rest), not a table")
         return
@@ -157,22 +159,15 @@ def overrides(scene, param: str, value: float) -> list:
         ``belt_speed`` sets the surface speed too, at the scene's ratio v/c.
     """
     if param == "driver_speed":
-        return [(_driver_speed(scene)[0], float(value))]
+        from ..beltdrive.scene import driver_speed_key
+
+        return [(driver_speed_key(scene.to_dict()), float(value))]
     keys = [(params_of(scene)[param], float(value))]
     if param == "belt_speed":
         motion = scene.to_dict()["motion"]
         ratio = motion["surface_speed"] / motion["belt_speed"]
         keys.append(("motion.surface_speed", ratio * float(value)))
     return keys
-
-
-def _driver_speed(scene) -> tuple[str, object]:
-    """A drive's key of its driver's speed, and the speed as the scene gives it."""
-    data = scene.to_dict()
-    if "pulley" not in data:  # the two-pulley shorthand
-        return "drive.driver_speed", data["drive"]["driver_speed"]
-    driver = next(p for p in data["pulley"] if "speed" in p)
-    return f"pulley.{driver['name']}.speed", driver["speed"]
 
 
 def check_values(scene, param: str, values) -> list[float]:
