@@ -59,6 +59,9 @@ SERPENTINE_ARGS = {
 FLUCTUATION = {False: {"seconds": 1.0, "laws": ("tanh", "exact"), "sets": ()},
                True: {"seconds": 0.02, "laws": ("tanh",),
                       "sets": (("numerics.elements", 120),)}}
+#: the modes' benchmark (benchmarks.modes), by mode: repeats; and the issue's target (s)
+MODES_REPEAT = {False: 5, True: 1}
+MODES_TARGET = 1.0
 TITLE = "Timings"
 INDEX_INTRO = (
     "How fast beltsim runs, measured by `python -m benchmarks.pages` on the machine its "
@@ -66,8 +69,8 @@ INDEX_INTRO = (
     "kernel, compilation and a cold start, against generic scipy peers and a numpy port "
     "of the default scheme; and the closed belt drive's start-up and steady scheme, run by "
     "the same engine as a closed layout, and a second of a crankshaft's speed "
-    "fluctuation on the accessory drive. `python -m benchmarks.pages --quick` does the "
-    "same on tiny grids (CI runs it).")
+    "fluctuation and the modes of the accessory drive. `python -m benchmarks.pages "
+    "--quick` does the same on tiny grids (CI runs it).")
 
 _KERNEL_LOAD = """
 import json, sys, time
@@ -242,6 +245,7 @@ def build(page: Page, quick: bool, cold: bool = True) -> None:
     _drive_section(page, quick, cold)
     _serpentine_section(page, quick)
     _fluctuation_section(page, quick)
+    _modes_section(page, quick)
     page.para(f"Load average at the end of the run: {os.getloadavg()[0]:.2f} (at the start: "
               f"see the top of the page); on this machine {os.cpu_count()} cores.")
 
@@ -414,6 +418,33 @@ def _fluctuation_section(page: Page, quick: bool) -> None:
                      f"{span}: {r['amplitudes'][span]:.6g} N" if span else ""])
     page.table(["law", "elements", "wall [s]", "wall per simulated second [s]", "steps",
                 "rejected", "Newton iterations a step", "tension amplitude"], rows)
+
+
+def _modes_section(page: Page, quick: bool) -> None:
+    from . import modes
+
+    repeat = MODES_REPEAT[quick]
+    page.heading("A drive's modes")
+    page.para(
+        f"`python -m benchmarks.modes serpentine_accessory --repeat {repeat}` (its "
+        "functions, called here): the accessory drive's rotational modes, numba's cache "
+        "warm, each the shortest of its repeats: the call `beltsim.modes(scene)` with the "
+        "kernels loaded (the steady solve, the linearisation, the shift-invert sweep of "
+        "the band for the least stable eigenvalue and the listing of the lowest modes); "
+        "`beltsim modes serpentine_accessory --out DIR` end to end in a fresh process, "
+        "which adds the interpreter, the imports and the kernels' load from the cache; "
+        "and those imports alone (beltsim's CLI, numpy, scipy.sparse.linalg, numba). "
+        f"The target: {MODES_TARGET:g} s.")
+    out = modes.bench("serpentine_accessory", repeat)
+    page.table(["quantity", "value"], [
+        ["grid: elements, method, eigenvalues found, modes listed",
+         f"{out['elements']}, {out['method']}, {out['eigenvalues']}, {out['modes']}"],
+        ["call, kernels loaded [s]", fmt(out["call"], ".3g")],
+        ["command in a fresh process [s]", fmt(out["command"], ".3g")],
+        ["its imports [s]", fmt(out["imports"], ".3g")]])
+    for what in ("call", "command"):
+        verdict = "met" if out[what] <= MODES_TARGET else "not met on this machine"
+        page.para(f"The {what}: {out[what]:.3g} s against {MODES_TARGET:g} s, {verdict}.")
 
 
 def main(argv=None) -> int:

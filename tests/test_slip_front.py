@@ -13,6 +13,7 @@ from beltsim.simulation.loop_solution import (
     stick_rate,
 )
 from helpers import ROOT
+from validation.slip_fronts import slip_arc_envelope
 
 
 @pytest.mark.unit
@@ -56,9 +57,6 @@ def test_stick_mode_is_the_grids_and_through_its_nodes():
     assert stick_mode(0.0, (-1e-3, -2e-3), (0.3, 0.2)) == pytest.approx((0.0, 0.4, 100.0))
 
 
-#: grids of each octave: the slip fronts' places within their cells cover (0, 1), so the
-#: largest error over them is the readout's envelope, free of one grid's luck
-OCTAVE = 8
 #: the slip arcs' envelope (largest error over an octave's grids, in the pulley's arc
 #: length over the largest element) from 1600 elements: measured 0.033 (drive_flat),
 #: 0.037 (serpentine_machine, serpentine_accessory), the discretisation's own front
@@ -70,22 +68,6 @@ ENVELOPE_1600 = 0.05
 ENVELOPE_ORDER = 1.75
 
 
-def _envelope(scene, n):
-    import beltsim
-
-    worst, h = 0.0, 0.0
-    for k in range(OCTAVE):
-        r = beltsim.run(scene.with_overrides({"numerics.elements": n + k * n // 64}))
-        assert r.converged, r.reason
-        sol, ex = r.solution, r.reference.summary()
-        hk = float(sol.mesh.he.max())
-        worst = max([worst] + [abs(a - p["slip_arc"]) * q.radius / hk
-                               for a, p, q in zip(sol.slip_arcs(), ex["pulleys"],
-                                                  sol.params.pulleys)])
-        h = max(h, hk)
-    return worst, h
-
-
 @pytest.mark.verification
 @pytest.mark.parametrize("name", ["drive_flat", "serpentine_machine", "serpentine_accessory"])
 def test_beam_slip_arcs_converge_at_second_order(name):
@@ -93,7 +75,8 @@ def test_beam_slip_arcs_converge_at_second_order(name):
 
     scene = DriveScene.load(str(ROOT / "runs" / f"{name}.toml")).with_overrides(
         {"physics.model": "beam", "numerics.integrator": "steady"})
-    (e1, h1), (e2, h2) = _envelope(scene, 1600), _envelope(scene, 6400)
+    (w1, h1), (w2, h2) = slip_arc_envelope(scene, 1600), slip_arc_envelope(scene, 6400)
+    e1, e2 = max(w1.values()), max(w2.values())
     assert e1 < ENVELOPE_1600, e1
     order = math.log(e1 * h1 / (e2 * h2)) / math.log(h1 / h2)
     assert order > ENVELOPE_ORDER, (e1, e2, order)

@@ -163,3 +163,24 @@ def test_the_cli_warns_once_and_writes_the_verdict(checking, tmp_path):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["stability"]["stable"] is False
     assert summary["stability"]["grid_damping"] > 0.0
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize("elements, expected", [(300, (300, 150)), (6400, (800, 400))])
+def test_a_drives_estimate_is_made_on_its_grid_up_to_the_checks_finest(tmp_path, monkeypatch,
+                                                                      elements, expected):
+    # the estimate's sweep costs about the square of the grid: a fine grid's run is
+    # checked on CHECK_ELEMENTS, and its half for the error
+    monkeypatch.setenv("BELTSIM_CACHE_DIR", str(tmp_path))
+    grids = []
+
+    def fake(scene, n=None):
+        grids.append(n)
+        return complex(-1.0 - 1e-3 * n, 2e4), n
+    monkeypatch.setattr(sc, "_rightmost", fake)
+    assert sc.CHECK_ELEMENTS == 800
+    scene = beltsim.load_scene("drive_flat").with_overrides({"numerics.elements": elements})
+    found = sc.discrete_least_stable(scene)
+    assert tuple(grids) == expected
+    assert found.elements == expected[0]
+    assert found.error == pytest.approx(1e-3 * (expected[0] - expected[1]))

@@ -53,7 +53,7 @@ def _cli_run_time(scene: Scene, env: dict, what: str) -> float:
     return wall
 
 
-def _user_env(**extra) -> dict:
+def user_env(**extra) -> dict:
     """The environment of a user's process: this one's, with Python's bytecode cache on
     (its default; a sandbox's PYTHONDONTWRITEBYTECODE would recompile every module of
     the package in every run, about 0.1 s that no installed package pays)."""
@@ -66,15 +66,15 @@ def cold_start_time(scene: Scene) -> float:
     """Wall time of ``beltsim run`` in a fresh process with an empty numba cache, from
     start to steady state (the scene written to a file first)."""
     with tempfile.TemporaryDirectory() as cache:
-        return _cli_run_time(scene, _user_env(NUMBA_CACHE_DIR=cache), "cold-start")
+        return _cli_run_time(scene, user_env(NUMBA_CACHE_DIR=cache), "cold-start")
 
 
 def warm_run_time(scene: Scene, repeat=3) -> float:
     """Wall time of ``beltsim run`` end to end in a fresh process whose kernels are in
     numba's cache and whose modules are in Python's bytecode cache (a first run puts
     both there, and is not counted), the shortest of ``repeat``."""
-    _cli_run_time(scene, _user_env(), "warm")
-    return min(_cli_run_time(scene, _user_env(), "warm") for _ in range(repeat))
+    _cli_run_time(scene, user_env(), "warm")
+    return min(_cli_run_time(scene, user_env(), "warm") for _ in range(repeat))
 
 
 def import_time(repeat=3) -> float:
@@ -84,7 +84,7 @@ def import_time(repeat=3) -> float:
     times = []
     for _ in range(repeat):
         proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                              env=_user_env())
+                              env=user_env())
         if proc.returncode != 0:
             raise RuntimeError(f"import beltsim failed: {proc.stderr.strip()}")
         times.append(float(proc.stdout))
