@@ -60,7 +60,8 @@ SOURCES = {
     "verification/balance.md": (*ENGINE, "validation/pages/balance.py"),
     "verification/drive.md": (*ENGINE, *DRIVE, "validation/slip_fronts.py",
                              "validation/pages/drive.py"),
-    "verification/serpentine.md": (*ENGINE, *DRIVE, "runs", "validation/pages/serpentine.py"),
+    "verification/serpentine.md": (*ENGINE, *DRIVE, "runs", "validation/slip_fronts.py",
+                                  "validation/pages/serpentine.py"),
     "performance/timings.md": (*ENGINE, *DRIVE, "src/beltsim/studies/bench.py",
                                "benchmarks"),
 }
