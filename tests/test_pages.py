@@ -1,8 +1,9 @@
 """The documentation's verification and performance pages, written by scripts.
 
 The quick modes run once each and must write well-formed pages (the command and the
-commit at the top, a table, every figure they show); a missing input or a failing study
-must make the scripts exit non-zero and say so on the page.
+commit at the top, a table, every figure they show) with the sections of the committed
+pages; a missing input or a failing study must make the scripts exit non-zero and say so
+on the page.
 """
 
 import itertools
@@ -46,6 +47,22 @@ def check_page(path: Path, command: str) -> str:
     return text
 
 
+def outline(text: str) -> list[tuple[int, str]]:
+    """A page's structure: its headings' levels and titles up to a colon, numbers left
+    out (a quick page draws fewer scenes on coarser grids under the same headings)."""
+    outside = re.sub(r"^```.*?^```", "", text, flags=re.MULTILINE | re.DOTALL)
+    return [(len(m.group(1)), re.sub(r"[\d.]+", "N", title.split(":")[0]).strip())
+            for m, title in ((m, outside[m.end():].split("\n", 1)[0])
+                             for m in HEADING.finditer(outside))]
+
+
+def same_outline(committed: Path, text: str) -> None:
+    """The committed page has the structure its script writes now: a page whose script
+    gained or lost a section since it was written is older than its code."""
+    assert outline(committed.read_text(encoding="utf-8")) == outline(text), (
+        f"{committed} does not have the sections its script writes now: rewrite it")
+
+
 def check_index(out: Path, pages, hand_written=()) -> None:
     text = (out / "index.md").read_text(encoding="utf-8")
     toc = text.split("```{toctree}")[1].split("```")[0]
@@ -65,6 +82,7 @@ def test_quick_verification_pages(tmp_path):
              for n in names}
     for name, text in texts.items():
         assert "```{error}" not in text, name
+        same_outline(vpages.DEFAULT_OUT / f"{name}.md", text)
     # the paper's Table 1, as printed, against the analytic values (the page's own check)
     assert "| No inertia, no slip | total | 12719 | 12718.58 |" in texts["paper"]
     assert "stability matrix" in texts["stability"] and "Random scenes" in texts["stability"]
@@ -75,6 +93,7 @@ def test_quick_performance_page(tmp_path):
     assert bpages.main(argv) == 0
     check_index(tmp_path, ["timings"])
     text = check_page(tmp_path / "timings.md", "python -m benchmarks.pages " + " ".join(argv))
+    same_outline(bpages.DEFAULT_OUT / "timings.md", text)
     assert "Machine: " in text and "numba " in text and "cores" in text
     for method in ("Radau", "BDF", "ported to numpy", "Newton"):
         assert method in text, method
