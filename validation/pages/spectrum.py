@@ -136,18 +136,24 @@ def chain_section(page: Page, cfg: dict, quick: bool) -> None:
             "of a physical transient is the grid's, and converges neither in the grid nor to "
             "the least stable root of a band ([flutter](flutter.md)). A run's stability entry "
             "names its band for this reason.")
+    roots_figure(page, points, f"Exact eigenvalues up to {bands[-1][1]:g} Hz",
+                 "exact_chain", "The exact roots band by band: growing roots in every "
+                 "octave, at rates that do not decay", bottom=-40.0, size=2)
+
+
+def roots_figure(page: Page, roots_by_scene: dict, title: str, name: str, caption: str,
+                 bottom: float, size: float) -> None:
+    """Exact roots as points in the (frequency, rate) plane, one series per (scene, d)."""
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
-    for (name, d), roots in points.items():
-        ax.plot(roots.imag / (2 * math.pi), roots.real, ".", ms=2,
-                label=f"{name}, d = {d:g} 1/s")
+    for (scene, d), roots in roots_by_scene.items():
+        ax.plot(roots.imag / (2 * math.pi), roots.real, ".", ms=size,
+                label=f"{scene}, d = {d:g} 1/s")
     ax.axhline(0.0, color="k", lw=0.8)
-    ax.set_ylim(-40, 25)
-    decorate(ax, "frequency [Hz]", "rate Re(lambda) [1/s]",
-             f"Exact eigenvalues up to {bands[-1][1]:g} Hz")
-    page.figure(fig, "exact_chain", "The exact roots band by band: growing roots in every "
-                                    "octave, at rates that do not decay")
+    ax.set_ylim(bottom, 25)
+    decorate(ax, "frequency [Hz]", "rate Re(lambda) [1/s]", title)
+    page.figure(fig, name, caption)
 
 
 def convergence_section(page: Page, cfg: dict, exact: dict) -> dict:
@@ -278,15 +284,6 @@ def build(page: Page, quick: bool) -> None:
     chain_section(page, cfg, quick)
     convergence_section(page, cfg, exact)
     paths_section(page, cfg)
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
-    for (name, d), roots in exact.items():
-        ax.plot(roots.imag / (2 * math.pi), roots.real, ".", ms=3,
-                label=f"{name}, d = {d:g} 1/s")
-    ax.axhline(0.0, color="k", lw=0.8)
-    ax.set_ylim(-60, 25)
-    decorate(ax, "frequency [Hz]", "rate Re(lambda) [1/s]",
-             "Exact eigenvalues of the linearised steady states")
-    page.figure(fig, "exact_spectrum", "The exact roots (physics.continuum) near the "
-                                       "imaginary axis: above zero they grow")
+    roots_figure(page, exact, "Exact eigenvalues of the linearised steady states",
+                 "exact_spectrum", "The exact roots (physics.continuum) near the imaginary "
+                 "axis: above zero they grow", bottom=-60.0, size=3)
